@@ -1,0 +1,1 @@
+//! molecule (under construction)

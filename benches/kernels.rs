@@ -45,17 +45,26 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("spmd_exp");
     g.throughput(Throughput::Elements(n as u64));
     for isa in Isa::under_test() {
-        g.bench_function(BenchmarkId::from_parameter(isa), |b| b.iter(|| isa.dispatch(ExpBatch(&xs))));
+        g.bench_function(BenchmarkId::from_parameter(isa), |b| {
+            b.iter(|| isa.dispatch(ExpBatch(&xs)))
+        });
     }
     g.finish();
 
     let table: Vec<f32> = (0..(1 << 20)).map(|i| i as f32).collect();
-    let idx: Vec<i32> = (0..n as u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 12) as i32).collect();
+    let idx: Vec<i32> = (0..n as u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 12) as i32)
+        .collect();
     let mut g = c.benchmark_group("spmd_gather");
     g.throughput(Throughput::Elements(n as u64));
     for isa in Isa::under_test() {
         g.bench_function(BenchmarkId::from_parameter(isa), |b| {
-            b.iter(|| isa.dispatch(GatherBatch { table: &table, idx: &idx }))
+            b.iter(|| {
+                isa.dispatch(GatherBatch {
+                    table: &table,
+                    idx: &idx,
+                })
+            })
         });
     }
     g.finish();

@@ -40,7 +40,11 @@ fn main() {
 fn run(cli: Cli) -> Result<()> {
     let isa = Isa::select(cli.isa)?;
     if cli.version {
-        println!("bnsview {} (isa: {isa}, {} lanes)", env!("CARGO_PKG_VERSION"), isa.lanes());
+        println!(
+            "bnsview {} (isa: {isa}, {} lanes)",
+            env!("CARGO_PKG_VERSION"),
+            isa.lanes()
+        );
         return Ok(());
     }
     match cli.command {

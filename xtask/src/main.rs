@@ -27,7 +27,10 @@ fn main() -> Result<()> {
 }
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
 }
 
 fn cargo() -> Command {
@@ -39,8 +42,16 @@ fn cargo() -> Command {
 /// Runs a command, echoing stdout/stderr to our stderr, and returns stdout + stderr.
 fn run_logged(mut cmd: Command, what: &str) -> Result<(bool, String)> {
     eprintln!("xtask: {what}");
-    let out = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).output().with_context(|| what.to_string())?;
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let out = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .output()
+        .with_context(|| what.to_string())?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     eprint!("{text}");
     Ok((out.status.success(), text))
 }
@@ -66,12 +77,23 @@ fn count_tests(text: &str) -> (u64, u64) {
 fn supported_isas() -> Result<Vec<String>> {
     // Ask the product itself, so the matrix agrees with what users see.
     let out = cargo()
-        .args(["run", "--release", "--quiet", "--bin", "bnsview", "--", "isa"])
+        .args([
+            "run",
+            "--release",
+            "--quiet",
+            "--bin",
+            "bnsview",
+            "--",
+            "isa",
+        ])
         .env_remove("BNS_ISA")
         .output()
         .context("running bnsview isa")?;
     if !out.status.success() {
-        bail!("bnsview isa failed: {}", String::from_utf8_lossy(&out.stderr));
+        bail!(
+            "bnsview isa failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let text = String::from_utf8_lossy(&out.stdout);
     Ok(text
@@ -87,16 +109,26 @@ fn supported_isas() -> Result<Vec<String>> {
 /// Median times (ns) of every criterion benchmark, keyed by (group, isa), read from
 /// `target/criterion/<group>/<isa>/new/estimates.json`.
 fn bench_medians() -> Result<BTreeMap<(String, String), f64>> {
-    let dir = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target"));
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"));
     let crit = dir.join("criterion");
     let mut out = BTreeMap::new();
-    let Ok(groups) = std::fs::read_dir(&crit) else { return Ok(out) };
+    let Ok(groups) = std::fs::read_dir(&crit) else {
+        return Ok(out);
+    };
     for g in groups.flatten() {
         for isa in ISAS {
             let f = g.path().join(isa).join("new").join("estimates.json");
             if let Ok(text) = std::fs::read_to_string(&f) {
                 if let Some(ns) = json_number_after(&text, "\"median\"", "\"point_estimate\"") {
-                    out.insert((g.file_name().to_string_lossy().into_owned(), isa.to_string()), ns);
+                    out.insert(
+                        (
+                            g.file_name().to_string_lossy().into_owned(),
+                            isa.to_string(),
+                        ),
+                        ns,
+                    );
                 }
             }
         }
@@ -110,7 +142,9 @@ fn json_number_after(text: &str, key1: &str, key2: &str) -> Option<f64> {
     let rest = &text[text.find(key1)?..];
     let rest = &rest[rest.find(key2)? + key2.len()..];
     let rest = rest.trim_start().strip_prefix(':')?.trim_start();
-    let end = rest.find(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c))).unwrap_or(rest.len());
+    let end = rest
+        .find(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c)))
+        .unwrap_or(rest.len());
     rest[..end].parse().ok()
 }
 
@@ -124,8 +158,12 @@ fn matrix(quick: bool) -> Result<()> {
     let mut all_ok = true;
     for isa in &isas {
         let mut c = cargo();
-        c.args(["test", "--release", "--workspace"]).env("BNS_ISA", isa);
-        let (ok, text) = run_logged(c, &format!("cargo test --release --workspace (BNS_ISA={isa})"))?;
+        c.args(["test", "--release", "--workspace"])
+            .env("BNS_ISA", isa);
+        let (ok, text) = run_logged(
+            c,
+            &format!("cargo test --release --workspace (BNS_ISA={isa})"),
+        )?;
         let (p, f) = count_tests(&text);
         all_ok &= ok && f == 0;
         test_rows.push((isa.clone(), p, f, ok));
@@ -153,7 +191,10 @@ fn matrix(quick: bool) -> Result<()> {
             .env("RUSTFLAGS", format!("-C target-cpu={cpu}"));
         let (ok, _) = run_logged(c, &format!("cargo build --release (target-cpu={cpu})"))?;
         let selected = if ok {
-            let out = Command::new(dir.join("release").join("bnsview")).arg("--version").env_remove("BNS_ISA").output()?;
+            let out = Command::new(dir.join("release").join("bnsview"))
+                .arg("--version")
+                .env_remove("BNS_ISA")
+                .output()?;
             String::from_utf8_lossy(&out.stdout).trim().to_string()
         } else {
             "build failed".to_string()
@@ -166,10 +207,20 @@ fn matrix(quick: bool) -> Result<()> {
 
     // The table.
     println!();
-    println!("== cargo xtask matrix{} ({:.0} s) ==", if quick { " --quick" } else { "" }, t0.elapsed().as_secs_f64());
+    println!(
+        "== cargo xtask matrix{} ({:.0} s) ==",
+        if quick { " --quick" } else { "" },
+        t0.elapsed().as_secs_f64()
+    );
     println!("{:<8} {:>7} {:>7}  tests", "isa", "passed", "failed");
     for (isa, p, f, ok) in &test_rows {
-        println!("{:<8} {:>7} {:>7}  {}", isa, p, f, if *ok && *f == 0 { "ok" } else { "FAILED" });
+        println!(
+            "{:<8} {:>7} {:>7}  {}",
+            isa,
+            p,
+            f,
+            if *ok && *f == 0 { "ok" } else { "FAILED" }
+        );
     }
     println!();
     let groups: Vec<String> = {
@@ -197,7 +248,12 @@ fn matrix(quick: bool) -> Result<()> {
     println!();
     println!("{:<10} {:<6} bnsview --version", "target-cpu", "ok");
     for (cpu, sel, good) in &cpu_rows {
-        println!("{:<10} {:<6} {}", cpu, if *good { "ok" } else { "FAILED" }, sel);
+        println!(
+            "{:<10} {:<6} {}",
+            cpu,
+            if *good { "ok" } else { "FAILED" },
+            sel
+        );
     }
     if !all_ok {
         bail!("matrix: something failed (see above)");
@@ -228,6 +284,9 @@ mod tests {
     #[test]
     fn reads_criterion_median() {
         let j = r#"{"mean":{"point_estimate":5.0},"median":{"confidence_interval":{"lower_bound":1.0},"point_estimate":123.5e3,"standard_error":2.0}}"#;
-        assert_eq!(json_number_after(j, "\"median\"", "\"point_estimate\""), Some(123500.0));
+        assert_eq!(
+            json_number_after(j, "\"median\"", "\"point_estimate\""),
+            Some(123500.0)
+        );
     }
 }

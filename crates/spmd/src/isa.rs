@@ -177,7 +177,11 @@ impl Isa {
 /// The `BNS_CPU_LIMIT` cap, read once.
 fn cpu_limit() -> Option<Isa> {
     static LIMIT: std::sync::OnceLock<Option<Isa>> = std::sync::OnceLock::new();
-    *LIMIT.get_or_init(|| std::env::var("BNS_CPU_LIMIT").ok().and_then(|v| v.parse().ok()))
+    *LIMIT.get_or_init(|| {
+        std::env::var("BNS_CPU_LIMIT")
+            .ok()
+            .and_then(|v| v.parse().ok())
+    })
 }
 
 impl fmt::Display for Isa {

@@ -161,7 +161,11 @@ impl Kernel for Apply<'_> {
     #[inline(always)]
     fn run<S: Simd>(self, s: S) -> Outputs {
         let inp = self.inp;
-        let mut out = Outputs { f: vec![0.0; N], i: vec![0; N], m: vec![0; N] };
+        let mut out = Outputs {
+            f: vec![0.0; N],
+            i: vec![0; N],
+            m: vec![0; N],
+        };
         for k in (0..N).step_by(S::LANES) {
             let a = s.load(&inp.a[k..]);
             let b = s.load(&inp.b[k..]);
@@ -275,7 +279,14 @@ fn normal_in_range(x: f32) -> bool {
 }
 
 /// Checks one float output lane against the scalar one, with the op's tolerance.
-fn check_float(op: Op, isa: Isa, inp: &Inputs, k: usize, got: f32, want: f32) -> Result<(), String> {
+fn check_float(
+    op: Op,
+    isa: Isa,
+    inp: &Inputs,
+    k: usize,
+    got: f32,
+    want: f32,
+) -> Result<(), String> {
     let (a, b, c) = (inp.a[k], inp.b[k], inp.c[k]);
     let ok = match op {
         Op::Fma if matches!(isa, Isa::Avx2 | Isa::Avx512) => {
@@ -398,7 +409,14 @@ fn inputs() -> impl Strategy<Value = Inputs> {
         prop::collection::vec(edge_i32(), N),
         prop_oneof![0u32..=33, Just(31), Just(32), Just(1000)],
     )
-        .prop_map(|(a, b, c, ia, ib, shift)| Inputs { a, b, c, ia, ib, shift })
+        .prop_map(|(a, b, c, ia, ib, shift)| Inputs {
+            a,
+            b,
+            c,
+            ia,
+            ib,
+            shift,
+        })
 }
 
 proptest! {
@@ -511,7 +529,10 @@ impl Kernel for Gathers<'_> {
             let idx = s.load_i(&self.idx[k..]);
             let fill = s.splat(self.fill);
             s.store(s.gather(self.data, idx, m, fill), &mut f[k..]);
-            s.store_i(s.gather_i(self.ints, idx, m, s.bitcast_i(fill)), &mut i[k..]);
+            s.store_i(
+                s.gather_i(self.ints, idx, m, s.bitcast_i(fill)),
+                &mut i[k..],
+            );
             s.store_i(s.gather_u8(self.bytes, idx, m), &mut b[k..]);
         }
         (f, i, b)
@@ -533,7 +554,10 @@ impl Kernel for MemOps<'_> {
         let mut out = vec![-7.25f32; self.out_len];
         s.store_masked(v, &mut out, s.mask_from_bits(self.bits));
         let mut partial = vec![0.0; 16];
-        s.store(s.load_partial(&self.vals[..self.out_len.min(16)], self.fill), &mut partial);
+        s.store(
+            s.load_partial(&self.vals[..self.out_len.min(16)], self.fill),
+            &mut partial,
+        );
         (out, partial)
     }
 }
@@ -589,14 +613,21 @@ fn gather_out_of_bounds_active_lane_panics() {
         #[inline(always)]
         fn run<S: Simd>(self, s: S) -> f32 {
             let data = [1.0f32; 5];
-            let idx = s.select_i(s.eq_i(s.lane_index(), s.splat_i(0)), s.splat_i(self.0), s.splat_i(0));
+            let idx = s.select_i(
+                s.eq_i(s.lane_index(), s.splat_i(0)),
+                s.splat_i(self.0),
+                s.splat_i(0),
+            );
             s.reduce_add(s.gather(&data, idx, s.splat_m(true), s.splat(0.0)))
         }
     }
     for isa in backends() {
         for bad in [5, 6, -1, i32::MAX, i32::MIN] {
             let r = std::panic::catch_unwind(|| isa.dispatch(Oob(bad)));
-            assert!(r.is_err(), "{isa}: gather at index {bad} of a 5-element slice did not panic");
+            assert!(
+                r.is_err(),
+                "{isa}: gather at index {bad} of a 5-element slice did not panic"
+            );
         }
         assert_eq!(isa.dispatch(Oob(4)), isa.lanes() as f32);
     }

@@ -171,7 +171,7 @@ fn matrix(quick: bool) -> Result<()> {
 
     // 2. Criterion kernel benches; each bench covers every supported ISA.
     let mut c = cargo();
-    c.args(["bench", "--workspace", "--benches", "--", "--noplot"]);
+    c.args(["bench", "--workspace", "--bench", "*", "--", "--noplot"]);
     if quick {
         c.arg("--quick");
     }
@@ -180,15 +180,30 @@ fn matrix(quick: bool) -> Result<()> {
     all_ok &= bench_ok;
     let medians = bench_medians()?;
 
-    // 3. Portable builds: the same binary must select AVX-512 at run time whatever the
+    // 3. Code generation: every backend's entry points in the kernels bench must use that
+    //    backend's registers and call no vector op out of line (a generic op that was not
+    //    inlined into the `#[target_feature]` entry point would be a call).
+    let asm_rows = asm_check()?;
+    all_ok &= asm_rows.iter().all(|r| r.ok);
+
+    // 4. Portable builds: the same binary must select AVX-512 at run time whatever the
     //    compile-time baseline (each target-cpu gets its own target dir).
     let mut cpu_rows = Vec::new();
     for cpu in CPUS {
-        let dir = root().join(format!("target-cpu-{cpu}"));
+        // The default build is the x86-64 baseline; the others get their own target dir
+        // because RUSTFLAGS rebuild every dependency.
+        let (dir, flags) = if cpu == "x86-64" {
+            (root().join("target"), String::new())
+        } else {
+            (
+                root().join(format!("target-cpu-{cpu}")),
+                format!("-C target-cpu={cpu}"),
+            )
+        };
         let mut c = cargo();
         c.args(["build", "--release", "--bin", "bnsview", "--target-dir"])
             .arg(&dir)
-            .env("RUSTFLAGS", format!("-C target-cpu={cpu}"));
+            .env("RUSTFLAGS", flags);
         let (ok, _) = run_logged(c, &format!("cargo build --release (target-cpu={cpu})"))?;
         let selected = if ok {
             let out = Command::new(dir.join("release").join("bnsview"))
@@ -246,6 +261,21 @@ fn matrix(quick: bool) -> Result<()> {
         println!();
     }
     println!();
+    println!(
+        "{:<8} {:>7} {:>9} {:>11}  asm of spmd entry points (kernels bench)",
+        "isa", "entries", "reg insns", "inner calls"
+    );
+    for r in &asm_rows {
+        println!(
+            "{:<8} {:>7} {:>9} {:>11}  {}",
+            r.isa,
+            r.entries,
+            r.wide,
+            r.bad_calls,
+            if r.ok { "ok" } else { "FAILED" }
+        );
+    }
+    println!();
     println!("{:<10} {:<6} bnsview --version", "target-cpu", "ok");
     for (cpu, sel, good) in &cpu_rows {
         println!(
@@ -259,6 +289,84 @@ fn matrix(quick: bool) -> Result<()> {
         bail!("matrix: something failed (see above)");
     }
     Ok(())
+}
+
+struct AsmRow {
+    isa: &'static str,
+    entries: usize,
+    wide: usize,
+    bad_calls: usize,
+    ok: bool,
+}
+
+/// Disassembles the `spmd::x86::<isa>::entry` instances of the kernels bench binary with
+/// `objdump` and counts instructions on the backend's registers and calls into spmd or
+/// `core::arch` code (which would mean a vector op was not inlined).
+fn asm_check() -> Result<Vec<AsmRow>> {
+    let mut c = cargo();
+    c.args([
+        "bench",
+        "--bench",
+        "kernels",
+        "--no-run",
+        "--message-format=short",
+    ]);
+    let (ok, text) = run_logged(c, "cargo bench --bench kernels --no-run")?;
+    if !ok {
+        bail!("building the kernels bench failed");
+    }
+    let exe = text
+        .lines()
+        .find_map(|l| {
+            l.trim()
+                .strip_prefix("Executable ")
+                .and_then(|r| r.split('(').nth(1))
+                .map(|p| p.trim_end_matches(')'))
+        })
+        .context("finding the kernels bench executable in cargo's output")?;
+    let exe = root().join(exe);
+    let dump = Command::new("objdump")
+        .args(["-d", "--no-show-raw-insn", "-C"])
+        .arg(&exe)
+        .output()
+        .context("running objdump (Debian package binutils)")?;
+    let dump = String::from_utf8_lossy(&dump.stdout);
+    let mut rows = Vec::new();
+    for (isa, module, reg) in [
+        ("sse4.1", "sse41", "%xmm"),
+        ("avx2", "avx2", "%ymm"),
+        ("avx512", "avx512", "%zmm"),
+    ] {
+        let header = format!("<spmd::x86::{module}::entry");
+        let (mut entries, mut wide, mut bad) = (0, 0, 0);
+        let mut inside = false;
+        for line in dump.lines() {
+            if line.ends_with(">:") {
+                inside = line.contains(&header);
+                entries += inside as usize;
+                continue;
+            }
+            if !inside {
+                continue;
+            }
+            wide += line.contains(reg) as usize;
+            if line.contains("call")
+                && (line.contains("core_arch")
+                    || line.contains("<spmd::x86")
+                    || line.contains("as spmd::Simd"))
+            {
+                bad += 1;
+            }
+        }
+        rows.push(AsmRow {
+            isa,
+            entries,
+            wide,
+            bad_calls: bad,
+            ok: entries > 0 && wide > 0 && bad == 0,
+        });
+    }
+    Ok(rows)
 }
 
 fn fmt_ns(ns: f64) -> String {

@@ -18,7 +18,7 @@ fn lattice(m: &Molecule) -> String {
 
 /// Write one frame as extended XYZ (`Properties=species:S:1:pos:R:3`, positions in Å with
 /// 5 decimals).
-pub fn write_xyz<W: Write>(w: &mut W, m: &Molecule, comment: &str) -> io::Result<()> {
+pub fn write_xyz<W: Write + ?Sized>(w: &mut W, m: &Molecule, comment: &str) -> io::Result<()> {
     writeln!(w, "{}", m.len())?;
     writeln!(
         w,
@@ -42,7 +42,11 @@ pub fn write_xyz<W: Write>(w: &mut W, m: &Molecule, comment: &str) -> io::Result
 /// Write one frame as a LAMMPS text dump with columns `id type element x y z`; types are
 /// numbered by ascending atomic number. The box is the cell if any, else the bounds padded
 /// by 1 Å (non-periodic `ff`).
-pub fn write_lammps_dump<W: Write>(w: &mut W, m: &Molecule, timestep: u64) -> io::Result<()> {
+pub fn write_lammps_dump<W: Write + ?Sized>(
+    w: &mut W,
+    m: &Molecule,
+    timestep: u64,
+) -> io::Result<()> {
     let counts = m.element_counts();
     let mut type_of = [0u32; 256];
     for (t, (z, _)) in counts.iter().enumerate() {

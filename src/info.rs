@@ -292,7 +292,8 @@ fn report(
         "BVH:       ~{:.1} MB (2*ceil((atoms+bonds)/4) = {bvh_nodes} nodes x 32 B)",
         mb(bvh_bytes)
     );
-    p!(out, 
+    p!(
+        out,
         "volume:    {}x{}x{} voxels at {vpa} /Å (bounds + 2 Å pad): {:.1} MB as u8, {:.1} MB as f32",
         dims[0],
         dims[1],

@@ -170,9 +170,9 @@ impl<'a> Rule<'a> {
             Some(p) => {
                 let (a, b) = (p.frac[i], p.frac[j]);
                 let mut f = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                for k in 0..3 {
-                    if p.periodic[k] {
-                        f[k] -= f[k].round();
+                for (fk, &per) in f.iter_mut().zip(&p.periodic) {
+                    if per {
+                        *fk -= fk.round();
                     }
                 }
                 let h = &p.h;
@@ -231,10 +231,9 @@ impl Grid {
         let max_cells = (2 * n + 1024) as f64;
         let (dims, wrap, keys): ([usize; 3], [bool; 3], Vec<u32>) = match &rule.pbc {
             Some(p) => {
-                let mut dims = [1usize; 3];
-                for k in 0..3 {
-                    dims[k] = ((p.widths[k] / cut).floor() as usize).clamp(1, 1 << 20);
-                }
+                let mut dims = p
+                    .widths
+                    .map(|w| ((w / cut).floor() as usize).clamp(1, 1 << 20));
                 while (dims[0] * dims[1] * dims[2]) as f64 > max_cells {
                     for d in dims.iter_mut() {
                         *d = (*d * 4 / 5).max(1);

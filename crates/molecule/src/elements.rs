@@ -31,6 +31,8 @@ pub struct Element {
 /// Largest atomic number in the table.
 pub const MAX_Z: u8 = 103;
 
+// Values are copied verbatim from the published tables.
+#[allow(clippy::excessive_precision)]
 static TABLE: [Element; 104] = [
     Element {
         symbol: "X",

@@ -177,6 +177,9 @@ fn normalize(p: [f64; 3]) -> [f64; 3] {
     [p[0] / n, p[1] / n, p[2] / n]
 }
 
+/// Generated atoms grouped by lattice layer: position (Å) and atomic number.
+type Layers = Vec<Vec<([f32; 3], u8)>>;
+
 /// Atoms of one kind on a lattice: `a` (Å), basis in fractions of the cubic cell.
 struct Lattice<'b> {
     a: f64,
@@ -187,19 +190,13 @@ struct Lattice<'b> {
 impl Lattice<'_> {
     /// Visit lattice points inside [lo, hi] (Å) for which `keep(p, basis_index, cell)`
     /// returns an element; returns them grouped by z-layer (parallel, ordered).
-    fn collect<F>(
-        &self,
-        lo: [f64; 3],
-        hi: [f64; 3],
-        count_only: bool,
-        keep: F,
-    ) -> (usize, Vec<Vec<([f32; 3], u8)>>)
+    fn collect<F>(&self, lo: [f64; 3], hi: [f64; 3], count_only: bool, keep: F) -> (usize, Layers)
     where
         F: Fn([f64; 3], usize, [i64; 3]) -> Option<u8> + Sync,
     {
         let c0 = [0, 1, 2].map(|k| ((lo[k] - self.offset[k]) / self.a).floor() as i64 - 1);
         let c1 = [0, 1, 2].map(|k| ((hi[k] - self.offset[k]) / self.a).ceil() as i64 + 1);
-        let layers: Vec<(usize, Vec<([f32; 3], u8)>)> = (c0[2]..=c1[2])
+        let layers: Vec<(usize, Vec<_>)> = (c0[2]..=c1[2])
             .into_par_iter()
             .map(|kz| {
                 let mut out = Vec::new();
@@ -232,7 +229,7 @@ impl Lattice<'_> {
     }
 }
 
-fn append(m: &mut Molecule, layers: Vec<Vec<([f32; 3], u8)>>) {
+fn append(m: &mut Molecule, layers: Layers) {
     let add: usize = layers.iter().map(Vec::len).sum();
     m.x.reserve(add);
     m.y.reserve(add);
@@ -366,6 +363,7 @@ fn fullerene_iter(k: usize, iters: usize) -> (Vec<[f64; 3]>, Vec<[u32; 2]>) {
     let mut tris: Vec<[u32; 3]> = Vec::new();
     for f in &faces {
         let mut idx = vec![vec![0u32; k + 1]; k + 1];
+        #[allow(clippy::needless_range_loop)] // (i, j) are lattice coordinates, not just indices
         for i in 0..=k {
             for j in 0..=k - i {
                 let mut key: Vec<(usize, usize)> = [(f[0], k - i - j), (f[1], i), (f[2], j)]

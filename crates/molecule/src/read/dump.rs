@@ -225,7 +225,13 @@ impl FrameParser for DumpParser {
             let mut p = [0f64; 3];
             for k in 0..3 {
                 let t = f(pc[k]);
-                match parse_f64(t) {
+                // Cartesian columns are stored as f32 anyway; scaled ones need f64.
+                let v = if kind == Coords::Cart {
+                    parse_f32(t).map(f64::from)
+                } else {
+                    parse_f64(t)
+                };
+                match v {
                     Some(v) if v.is_finite() => p[k] = v,
                     Some(_) => {
                         let t = t.to_vec();
@@ -316,6 +322,8 @@ impl FrameParser for DumpParser {
         if !ids.is_empty() && !ids.windows(2).all(|w| w[0] <= w[1]) {
             let mut perm: Vec<u32> = (0..n as u32).collect();
             perm.sort_unstable_by_key(|&i| ids[i as usize]);
+            // Free the ids before permuting (peak memory ≤ ~1.4× the final arrays).
+            drop(ids);
             apply_perm(&mut m, &perm);
         }
         Ok(Some(m))

@@ -13,6 +13,9 @@ use super::{FrameParser, LineReader, ReadError, ReadOptions};
 use crate::{elements, Cell, Molecule};
 use std::collections::HashMap;
 
+/// One parsed `Atoms` line: id, type, position (Å), molecule id, charge, image flags.
+type AtomLine = (i64, i64, [f64; 3], f32, f32, [i64; 3]);
+
 pub(crate) struct DataParser {
     opts: ReadOptions,
     done: bool,
@@ -96,7 +99,7 @@ impl FrameParser for DataParser {
         let mut section = Section::Header;
         let mut style: Option<Style> = None;
         // Atoms: (id, type, x, y, z, mol, q)
-        let mut atoms: Vec<(i64, i64, [f64; 3], f32, f32, [i64; 3])> = Vec::new();
+        let mut atoms: Vec<AtomLine> = Vec::new();
         let mut bonds_raw: Vec<(u64, i64, i64)> = Vec::new();
         let mut spans = Vec::new();
         let mut has_mol = false;

@@ -299,9 +299,16 @@ pub(crate) fn parse_f64(b: &[u8]) -> Option<f64> {
     }
 }
 
-/// Parse an `f32`.
+/// Parse an `f32`, with a fast path for short integers (ids, types).
 #[inline]
 pub(crate) fn parse_f32(b: &[u8]) -> Option<f32> {
+    if !b.is_empty() && b.len() <= 7 && b.iter().all(u8::is_ascii_digit) {
+        let mut v = 0u32;
+        for &c in b {
+            v = v * 10 + u32::from(c - b'0');
+        }
+        return Some(v as f32);
+    }
     match fast_float2::parse::<f32, _>(b) {
         Ok(v) => Some(v),
         Err(_) => parse_f64(b).map(|v| v as f32),

@@ -121,7 +121,7 @@ fn parse_header(
             });
         } else if k.eq_ignore_ascii_case("Properties") {
             let parts: Vec<&str> = v.split(':').collect();
-            if parts.len() % 3 != 0 {
+            if !parts.len().is_multiple_of(3) {
                 return Err(r.error(line_no, "Properties=name:type:count triples", v.as_bytes()));
             }
             let mut col = 0usize;

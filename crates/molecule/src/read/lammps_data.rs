@@ -13,9 +13,6 @@ use super::{FrameParser, LineReader, ReadError, ReadOptions};
 use crate::{elements, Cell, Molecule};
 use std::collections::HashMap;
 
-/// One parsed `Atoms` line: id, type, position (Å), molecule id, charge, image flags.
-type AtomLine = (i64, i64, [f64; 3], f32, f32, [i64; 3]);
-
 pub(crate) struct DataParser {
     opts: ReadOptions,
     done: bool,
@@ -99,7 +96,12 @@ impl FrameParser for DataParser {
         let mut section = Section::Header;
         let mut style: Option<Style> = None;
         // Atoms: (id, type, x, y, z, mol, q)
-        let mut atoms: Vec<AtomLine> = Vec::new();
+        // Atoms, structure-of-arrays in file order (sorted by id at the end).
+        let mut ids: Vec<i64> = Vec::new();
+        let mut types: Vec<i32> = Vec::new();
+        let mut pos = Molecule::default();
+        let mut mols: Vec<f32> = Vec::new();
+        let mut qs: Vec<f32> = Vec::new();
         let mut bonds_raw: Vec<(u64, i64, i64)> = Vec::new();
         let mut spans = Vec::new();
         let mut has_mol = false;
@@ -206,6 +208,7 @@ impl FrameParser for DataParser {
                     let id =
                         parse_i64(f(0)).ok_or_else(|| ec.error(ln, "an integer atom id", f(0)))?;
                     let ty = parse_i64(f(tc))
+                        .and_then(|t| i32::try_from(t).ok())
                         .ok_or_else(|| ec.error(ln, "an integer atom type", f(tc)))?;
                     let mut p = [0f64; 3];
                     for (k, pk) in p.iter_mut().enumerate() {
@@ -250,7 +253,33 @@ impl FrameParser for DataParser {
                         }
                         None => 0.0,
                     };
-                    atoms.push((id, ty, p, mol, q, image));
+                    if ids.is_empty() {
+                        let cap = n_atoms.unwrap_or(0).min(1 << 26);
+                        ids.reserve(cap);
+                        types.reserve(cap);
+                        pos = Molecule::with_capacity(cap);
+                    }
+                    if image != [0; 3] {
+                        let e = [
+                            [lo_hi[0][1] - lo_hi[0][0], 0.0, 0.0],
+                            [tilt[0], lo_hi[1][1] - lo_hi[1][0], 0.0],
+                            [tilt[1], tilt[2], lo_hi[2][1] - lo_hi[2][0]],
+                        ];
+                        for (k, pk) in p.iter_mut().enumerate() {
+                            *pk += image[0] as f64 * e[0][k]
+                                + image[1] as f64 * e[1][k]
+                                + image[2] as f64 * e[2][k];
+                        }
+                    }
+                    ids.push(id);
+                    types.push(ty);
+                    pos.push([p[0] as f32, p[1] as f32, p[2] as f32], 0);
+                    if mc.is_some() {
+                        mols.push(mol);
+                    }
+                    if qc.is_some() {
+                        qs.push(q);
+                    }
                 }
                 Section::Bonds => {
                     let w: Vec<&[u8]> = fields(body).take(4).collect();
@@ -271,12 +300,12 @@ impl FrameParser for DataParser {
             let next = r.line_no() + 1;
             return Err(r.error(next, "an 'N atoms' header line", b"end of file"));
         };
-        if atoms.len() != n {
+        if ids.len() != n {
             let next = r.line_no() + 1;
             return Err(r.error(
                 next,
                 &format!("{n} lines in the Atoms section (header says {n} atoms)"),
-                format!("{} atom lines", atoms.len()).as_bytes(),
+                format!("{} atom lines", ids.len()).as_bytes(),
             ));
         }
         if !bonds_raw.is_empty() && bonds_raw.len() != n_bonds {
@@ -287,8 +316,12 @@ impl FrameParser for DataParser {
                 format!("{} bond lines", bonds_raw.len()).as_bytes(),
             ));
         }
-        atoms.sort_by_key(|a| a.0);
-        if atoms.windows(2).any(|w| w[0].0 == w[1].0) {
+        // Sort by id; ids are freed before the other columns are permuted.
+        let mut perm: Vec<u32> = (0..n as u32).collect();
+        perm.sort_unstable_by_key(|&i| ids[i as usize]);
+        let sorted_ids: Vec<i64> = perm.iter().map(|&i| ids[i as usize]).collect();
+        drop(ids);
+        if sorted_ids.windows(2).any(|w| w[0] == w[1]) {
             let next = r.line_no();
             return Err(r.error(
                 next,
@@ -296,28 +329,20 @@ impl FrameParser for DataParser {
                 b"a duplicate id",
             ));
         }
-        let mut m = Molecule::with_capacity(n);
-        let mut type_z: HashMap<i64, u8> = HashMap::new();
-        let edges = [
-            [lo_hi[0][1] - lo_hi[0][0], 0.0, 0.0],
-            [tilt[0], lo_hi[1][1] - lo_hi[1][0], 0.0],
-            [tilt[1], tilt[2], lo_hi[2][1] - lo_hi[2][0]],
-        ];
-        for &(_, ty, mut p, _, _, im) in &atoms {
-            if im != [0; 3] {
-                for (k, pk) in p.iter_mut().enumerate() {
-                    *pk += im[0] as f64 * edges[0][k]
-                        + im[1] as f64 * edges[1][k]
-                        + im[2] as f64 * edges[2][k];
-                }
-            }
-            let z = match type_z.get(&ty) {
+        let mut m = pos;
+        let mut type_z: HashMap<i32, u8> = HashMap::new();
+        for (e, &ty) in m.elements.iter_mut().zip(&types) {
+            *e = match type_z.get(&ty) {
                 Some(&z) => z,
                 None => {
                     let z = u32::try_from(ty)
                         .ok()
                         .and_then(|t| self.opts.type_element(t))
-                        .or_else(|| masses.get(&ty).and_then(|&m| elements::by_mass(m as f32)));
+                        .or_else(|| {
+                            masses
+                                .get(&i64::from(ty))
+                                .and_then(|&m| elements::by_mass(m as f32))
+                        });
                     let z = z.unwrap_or_else(|| {
                         self.warnings.push(format!(
                             "{}: atom type {ty} has no element (no matching mass, not in --types); treated as unknown (Z = 0)",
@@ -329,20 +354,24 @@ impl FrameParser for DataParser {
                     z
                 }
             };
-            m.push([p[0] as f32, p[1] as f32, p[2] as f32], z);
         }
         m.scalars
-            .push(("id".into(), atoms.iter().map(|a| a.0 as f32).collect()));
-        m.scalars
-            .push(("type".into(), atoms.iter().map(|a| a.1 as f32).collect()));
+            .push(("type".into(), types.iter().map(|&t| t as f32).collect()));
+        drop(types);
         if has_mol {
-            m.scalars
-                .push(("mol".into(), atoms.iter().map(|a| a.3).collect()));
+            m.scalars.push(("mol".into(), mols));
         }
         if has_q {
-            m.scalars
-                .push(("q".into(), atoms.iter().map(|a| a.4).collect()));
+            m.scalars.push(("q".into(), qs));
         }
+        // Everything above is in file order: permute it all into id order.
+        super::dump::apply_perm(&mut m, &perm);
+        drop(perm);
+        m.scalars.insert(
+            0,
+            ("id".into(), sorted_ids.iter().map(|&i| i as f32).collect()),
+        );
+        let sorted_ids = sorted_ids;
         if have_box.iter().all(|&b| b) {
             let [x, y, z] = lo_hi;
             m.cell = Some(Cell {
@@ -356,7 +385,7 @@ impl FrameParser for DataParser {
             });
         }
         if !bonds_raw.is_empty() {
-            let index = |id: i64| atoms.binary_search_by_key(&id, |a| a.0).ok();
+            let index = |id: i64| sorted_ids.binary_search(&id).ok();
             let mut bonds = Vec::with_capacity(bonds_raw.len());
             for &(ln, a, b) in &bonds_raw {
                 match (index(a), index(b)) {

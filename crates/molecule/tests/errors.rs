@@ -244,6 +244,14 @@ fn data_ok_and_errors() {
     assert_eq!(m.elements, vec![13, 8]);
     assert_eq!(m.scalar("q").unwrap(), &[1.5, -1.0]);
     assert_eq!(m.file_bonds.as_deref(), Some(&[[0u32, 1]][..]));
+    assert_eq!(m.scalar("id").unwrap(), &[1.0, 2.0]);
+    assert_eq!(m.scalar("type").unwrap(), &[1.0, 2.0]);
+    // image flags unwrap: x + 1·10, z - 1·10
+    let img = DATA
+        .replace("1 1 1.5 0 0 0", "1 1 1.5 0 0 0 1 0 -1")
+        .replace("2 2 -1.0 1 1 1", "2 2 -1.0 1 1 1 0 0 0");
+    let m = &parse(Format::LammpsData, &img).unwrap()[0];
+    assert_eq!(m.position(0), [10.0, 0.0, -10.0]);
     parse_err(
         Format::LammpsData,
         &DATA.replace("2 atoms", "3 atoms"),
@@ -285,6 +293,11 @@ const GRO: &str = "t\n2\n    1SOL     OW    1   0.100   0.200   0.300\n    1SOL 
 
 #[test]
 fn gro_ok_and_errors() {
+    assert_eq!(
+        parse(Format::Gro, &format!("{GRO}{GRO}")).unwrap().len(),
+        2,
+        "two frames"
+    );
     let m = &parse(Format::Gro, GRO).unwrap()[0];
     assert_eq!(m.elements, vec![8, 1]);
     assert!((m.x[1] - 1.5).abs() < 1e-6, "nm -> Å");

@@ -371,7 +371,6 @@ impl FrameParser for DataParser {
             0,
             ("id".into(), sorted_ids.iter().map(|&i| i as f32).collect()),
         );
-        let sorted_ids = sorted_ids;
         if have_box.iter().all(|&b| b) {
             let [x, y, z] = lo_hi;
             m.cell = Some(Cell {

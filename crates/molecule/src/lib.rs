@@ -3,6 +3,11 @@
 //! built-in reference scenes ([`scenes`]).
 //!
 //! All lengths are in Ångström (Å), positions are stored as `f32` structure-of-arrays.
+//!
+//! Crates doing the heavy lifting: `fast-float2` (float parsing), `memchr` (line splitting),
+//! `flate2` (gzip), `rayon` (parallel bonds and scene generation), `thiserror` (errors).
+//! Element data was generated from ASE's tables (see [`elements`]); the sample-file oracle is
+//! `tests/oracle/make_expected.py` (ASE 3.29).
 
 pub mod bonds;
 pub mod elements;

@@ -1,5 +1,5 @@
 //! Molecular data for bnsview: the [`Molecule`] frame type, the [`elements`] table, file
-//! readers ([`read`]), writers ([`write`]), the uniform-grid bond builder ([`bonds`]) and the
+//! readers ([`read`]), writers ([`mod@write`]), the uniform-grid bond builder ([`bonds`]) and the
 //! built-in reference scenes ([`scenes`]).
 //!
 //! All lengths are in Ångström (Å), positions are stored as `f32` structure-of-arrays.

@@ -4,6 +4,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use spmd::Isa;
 
+mod generate;
+mod info;
 mod isa_cmd;
 
 /// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,
@@ -28,6 +30,11 @@ struct Cli {
 enum Command {
     /// List the SIMD backends, whether this CPU supports each, and which one is selected.
     Isa,
+    /// Describe a molecule file or a built-in scene: atoms, frames, elements, bounds, bonds,
+    /// memory estimates.
+    Info(info::InfoArgs),
+    /// Write a built-in reference scene to a file (.xyz or .lammpstrj, optionally .gz).
+    Generate(generate::GenerateArgs),
 }
 
 fn main() {
@@ -49,6 +56,8 @@ fn run(cli: Cli) -> Result<()> {
     }
     match cli.command {
         Some(Command::Isa) => isa_cmd::run(isa),
+        Some(Command::Info(args)) => info::run(args),
+        Some(Command::Generate(args)) => generate::run(args),
         None => {
             use clap::CommandFactory;
             Cli::command().print_help()?;

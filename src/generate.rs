@@ -60,7 +60,7 @@ pub fn run(args: GenerateArgs) -> anyhow::Result<()> {
             anyhow::Error::new(e).context(format!("cannot create {}", args.output.display()))
         }
     })?;
-    let pb = crate::info::spinner(&format!("generating {}", args.scene));
+    let pb = crate::input::spinner(&format!("generating {}", args.scene));
     let t = Instant::now();
     let m = generate(args.scene, args.atoms, args.seed);
     let gen_s = t.elapsed().as_secs_f64();

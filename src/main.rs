@@ -6,6 +6,7 @@ use spmd::Isa;
 
 mod generate;
 mod info;
+mod input;
 mod isa_cmd;
 
 /// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,

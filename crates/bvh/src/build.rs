@@ -1,0 +1,423 @@
+//! BVH builders: binned SAH, parallel over subtrees (the fast one), and the paper's full-sweep
+//! SAH over presorted lists (§4.1, the quality reference).
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::geometry::{prim_refs, Aabb, Geometry, PrimRef};
+use crate::tree::{refs_bounds, Builder, Bvh, Node, INNER, LEAF_MAX};
+
+/// Most bins the binned builder supports.
+pub const MAX_BINS: usize = 32;
+/// Subtrees with at least this many primitives on both sides are built in parallel.
+const PAR_SUBTREE: usize = 4096;
+/// Nodes with at least this many primitives are binned in parallel.
+const PAR_BIN: usize = 1 << 16;
+
+/// Options of the binned SAH builder.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    /// Number of bins per axis (2..=[`MAX_BINS`]); small nodes use at most one bin per primitive.
+    pub bins: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions { bins: MAX_BINS }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    b: Aabb,
+    n: u32,
+}
+
+const EMPTY_BIN: Bin = Bin {
+    b: Aabb::EMPTY,
+    n: 0,
+};
+
+type Bins = [[Bin; MAX_BINS]; 3];
+
+/// Where a primitive's (doubled) centroid falls along each axis.
+#[derive(Clone, Copy)]
+struct Binner {
+    min: [f32; 3],
+    scale: [f32; 3],
+    nb: usize,
+}
+
+impl Binner {
+    fn new(cb: &Aabb, nb: usize) -> Binner {
+        let mut scale = [0.0; 3];
+        for (k, s) in scale.iter_mut().enumerate() {
+            let ext = cb.max[k] - cb.min[k];
+            if ext > 0.0 && ext.is_finite() {
+                *s = nb as f32 * (1.0 - 1e-6) / ext;
+            }
+        }
+        Binner {
+            min: cb.min,
+            scale,
+            nb,
+        }
+    }
+    #[inline(always)]
+    fn bin(&self, r: &PrimRef, k: usize) -> usize {
+        // `as usize` saturates (NaN -> 0), the `min` keeps rounding at the top edge in range.
+        (((r.centroid2(k) - self.min[k]) * self.scale[k]) as usize).min(self.nb - 1)
+    }
+    fn fill(&self, refs: &[PrimRef], bins: &mut Bins) {
+        for r in refs {
+            let b = r.aabb();
+            for (k, axis_bins) in bins.iter_mut().enumerate() {
+                let bin = &mut axis_bins[self.bin(r, k)];
+                bin.b = bin.b.union(b);
+                bin.n += 1;
+            }
+        }
+    }
+}
+
+fn merge_bins(mut a: Bins, b: &Bins) -> Bins {
+    for k in 0..3 {
+        for i in 0..MAX_BINS {
+            a[k][i].b = a[k][i].b.union(b[k][i].b);
+            a[k][i].n += b[k][i].n;
+        }
+    }
+    a
+}
+
+/// Result of splitting a node's refs in place: the left part is `refs[..nl]`.
+struct Split {
+    axis: u32,
+    nl: usize,
+    lb: Aabb,
+    lcb: Aabb,
+    rb: Aabb,
+    rcb: Aabb,
+}
+
+/// Finds the binned-SAH split of `refs` and partitions them in place.
+fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
+    let n = refs.len();
+    let nb = nb.min(n).clamp(2, MAX_BINS);
+    let binner = Binner::new(cb, nb);
+    let bins = if n >= PAR_BIN {
+        refs.par_chunks(1 << 14)
+            .fold(
+                || [[EMPTY_BIN; MAX_BINS]; 3],
+                |mut acc, c| {
+                    binner.fill(c, &mut acc);
+                    acc
+                },
+            )
+            .reduce(|| [[EMPTY_BIN; MAX_BINS]; 3], |a, b| merge_bins(a, &b))
+    } else {
+        let mut b = [[EMPTY_BIN; MAX_BINS]; 3];
+        binner.fill(refs, &mut b);
+        b
+    };
+
+    // Sweep: cost of splitting after bin i = A(left)·N(left) + A(right)·N(right).
+    let mut best: Option<(f32, usize, usize)> = None;
+    for (k, axis_bins) in bins.iter().enumerate() {
+        if binner.scale[k] == 0.0 {
+            continue;
+        }
+        let mut rcost = [0.0f32; MAX_BINS];
+        let mut rcount = [0u32; MAX_BINS];
+        let mut acc = Aabb::EMPTY;
+        let mut cnt = 0u32;
+        for i in (1..nb).rev() {
+            acc = acc.union(axis_bins[i].b);
+            cnt += axis_bins[i].n;
+            rcost[i - 1] = acc.area() * cnt as f32;
+            rcount[i - 1] = cnt;
+        }
+        let mut acc = Aabb::EMPTY;
+        let mut cnt = 0u32;
+        for i in 0..nb - 1 {
+            acc = acc.union(axis_bins[i].b);
+            cnt += axis_bins[i].n;
+            if cnt == 0 || rcount[i] == 0 {
+                continue;
+            }
+            let cost = acc.area() * cnt as f32 + rcost[i];
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, k, i));
+            }
+        }
+    }
+
+    let Some((_, k, pos)) = best else {
+        // Every centroid in the same place: split the run in the middle.
+        let nl = n / 2;
+        let (l, r) = refs.split_at(nl);
+        return Split {
+            axis: 0,
+            nl,
+            lb: refs_bounds(l),
+            lcb: *cb,
+            rb: refs_bounds(r),
+            rcb: *cb,
+        };
+    };
+    let mut lb = Aabb::EMPTY;
+    let mut rb = Aabb::EMPTY;
+    for (i, bin) in bins[k][..nb].iter().enumerate() {
+        if i <= pos {
+            lb = lb.union(bin.b);
+        } else {
+            rb = rb.union(bin.b);
+        }
+    }
+    // Partition in place; every element is classified exactly once.
+    let (mut i, mut j) = (0, n);
+    let mut lcb = Aabb::EMPTY;
+    let mut rcb = Aabb::EMPTY;
+    while i < j {
+        let r = refs[i];
+        let c = [r.centroid2(0), r.centroid2(1), r.centroid2(2)];
+        if binner.bin(&r, k) <= pos {
+            lcb.grow(c);
+            i += 1;
+        } else {
+            rcb.grow(c);
+            j -= 1;
+            refs.swap(i, j);
+        }
+    }
+    Split {
+        axis: k as u32,
+        nl: i,
+        lb,
+        lcb,
+        rb,
+        rcb,
+    }
+}
+
+/// Builds the subtree of `refs` under `node`. `region` (global index `region_base`) receives
+/// all descendants; it has room for `2·n − 2` nodes, which is enough for any binary tree with
+/// at least one primitive per leaf. Children pairs come first, then the left descendants'
+/// region, then the right's. Unused slots are dropped by [`compact`].
+#[allow(clippy::too_many_arguments)]
+fn build_node<'a>(
+    mut refs: &'a mut [PrimRef],
+    mut ref_base: usize,
+    mut bounds: Aabb,
+    mut cb: Aabb,
+    mut node: &'a mut Node,
+    mut region: &'a mut [Node],
+    mut region_base: usize,
+    nb: usize,
+) {
+    loop {
+        node.set_aabb(&bounds);
+        let n = refs.len();
+        if n <= LEAF_MAX {
+            node.first = ref_base as u32;
+            node.meta = n as u32;
+            return;
+        }
+        let s = split(refs, &cb, nb);
+        let (nl, nr) = (s.nl, n - s.nl);
+        node.first = region_base as u32;
+        node.meta = INNER | s.axis;
+        let (pair, rest) = std::mem::take(&mut region).split_at_mut(2);
+        let (lreg, rreg) = rest.split_at_mut(2 * nl - 2);
+        let (lrefs, rrefs) = std::mem::take(&mut refs).split_at_mut(nl);
+        let (lnode, rnode) = pair.split_at_mut(1);
+        let (lnode, rnode) = (&mut lnode[0], &mut rnode[0]);
+        let (lbase, rbase) = (region_base + 2, region_base + 2 * nl);
+        let (lref_base, rref_base) = (ref_base, ref_base + nl);
+        if nl >= PAR_SUBTREE && nr >= PAR_SUBTREE {
+            rayon::join(
+                || build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb),
+                || build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb),
+            );
+            return;
+        }
+        // Recurse into the smaller side, loop on the larger: stack depth stays O(log n).
+        if nl <= nr {
+            build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb);
+            (refs, ref_base, bounds, cb, node, region, region_base) =
+                (rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase);
+        } else {
+            build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb);
+            (refs, ref_base, bounds, cb, node, region, region_base) =
+                (lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase);
+        }
+    }
+}
+
+/// Copies the reachable nodes of a sparse slot array into a dense one (depth first, children
+/// pairs kept adjacent).
+fn compact(slots: &[Node]) -> Vec<Node> {
+    let mut out = Vec::with_capacity(slots.len() / 2 + 1);
+    out.push(slots[0]);
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((old, new)) = stack.pop() {
+        let n = slots[old];
+        if n.is_leaf() {
+            continue;
+        }
+        let c = out.len();
+        out.push(slots[n.first as usize]);
+        out.push(slots[n.first as usize + 1]);
+        out[new].first = c as u32;
+        stack.push((n.first as usize + 1, c + 1));
+        stack.push((n.first as usize, c));
+    }
+    out
+}
+
+impl Bvh {
+    /// Binned SAH build with default options (32 bins, ≤ 4 primitives per leaf), parallel over
+    /// subtrees on the current rayon pool.
+    pub fn build(g: &Geometry) -> Bvh {
+        Bvh::build_with(g, &BuildOptions::default())
+    }
+
+    /// Binned SAH build (§4.1 step 4, binned as in Wald 2007 instead of the paper's sweep).
+    pub fn build_with(g: &Geometry, opt: &BuildOptions) -> Bvh {
+        let start = Instant::now();
+        let nb = opt.bins.clamp(2, MAX_BINS);
+        let (mut refs, bounds, cb) = prim_refs(g);
+        let n = refs.len();
+        let nodes = if n == 0 {
+            vec![Node::default()]
+        } else {
+            let mut slots = vec![Node::default(); 2 * n - 1];
+            let (root, region) = slots.split_at_mut(1);
+            build_node(&mut refs, 0, bounds, cb, &mut root[0], region, 1, nb);
+            compact(&slots)
+        };
+        let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id).collect();
+        Bvh::finish(g, nodes, order, Builder::Binned, start)
+    }
+
+    /// The paper's builder (§4.1): primitives presorted along x, y and z; each node sweeps all
+    /// three sorted lists and takes the split of least SAH cost. Exact but sequential and
+    /// slow (O(n log n) per level): meant as the quality reference on ≤ 100K primitives.
+    pub fn build_full_sweep(g: &Geometry) -> Bvh {
+        let start = Instant::now();
+        let (refs, _, _) = prim_refs(g);
+        let n = refs.len();
+        if n == 0 {
+            return Bvh::finish(
+                g,
+                vec![Node::default()],
+                Vec::new(),
+                Builder::FullSweep,
+                start,
+            );
+        }
+        let sorted = |k: usize| {
+            let mut v: Vec<u32> = (0..n as u32).collect();
+            v.par_sort_unstable_by(|&a, &b| {
+                refs[a as usize]
+                    .centroid2(k)
+                    .total_cmp(&refs[b as usize].centroid2(k))
+                    .then(a.cmp(&b))
+            });
+            v
+        };
+        let (mut lx, mut ly, mut lz) = (sorted(0), sorted(1), sorted(2));
+        let mut st = Sweep {
+            refs: &refs,
+            nodes: vec![Node::default()],
+            order: Vec::with_capacity(n),
+            left: vec![false; n],
+            tmp: Vec::with_capacity(n),
+            rcost: vec![0.0; n],
+        };
+        st.build([&mut lx, &mut ly, &mut lz], 0);
+        let Sweep { nodes, order, .. } = st;
+        Bvh::finish(g, nodes, order, Builder::FullSweep, start)
+    }
+}
+
+struct Sweep<'r> {
+    refs: &'r [PrimRef],
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+    left: Vec<bool>,
+    tmp: Vec<u32>,
+    rcost: Vec<f32>,
+}
+
+impl Sweep<'_> {
+    fn build(&mut self, lists: [&mut [u32]; 3], at: usize) {
+        let n = lists[0].len();
+        let bounds = lists[0]
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(self.refs[i as usize].aabb()));
+        self.nodes[at].set_aabb(&bounds);
+        if n <= LEAF_MAX {
+            self.nodes[at].first = self.order.len() as u32;
+            self.nodes[at].meta = n as u32;
+            self.order.extend_from_slice(lists[0]);
+            return;
+        }
+        // Sweep every axis: cost of putting the first i primitives left.
+        let mut best = (f32::INFINITY, 0usize, n / 2);
+        for (k, list) in lists.iter().enumerate() {
+            let mut acc = Aabb::EMPTY;
+            for i in (1..n).rev() {
+                acc = acc.union(self.refs[list[i] as usize].aabb());
+                self.rcost[i] = acc.area() * (n - i) as f32;
+            }
+            let mut acc = Aabb::EMPTY;
+            for i in 1..n {
+                acc = acc.union(self.refs[list[i - 1] as usize].aabb());
+                let cost = acc.area() * i as f32 + self.rcost[i];
+                if cost < best.0 {
+                    best = (cost, k, i);
+                }
+            }
+        }
+        let (_, k, nl) = best;
+        for &id in lists[k][..nl].iter() {
+            self.left[id as usize] = true;
+        }
+        for &id in lists[k][nl..].iter() {
+            self.left[id as usize] = false;
+        }
+        let [a, b, c] = lists;
+        let mut parts = [a, b, c];
+        for (kk, list) in parts.iter_mut().enumerate() {
+            if kk == k {
+                continue;
+            }
+            // Stable partition by the left flags.
+            self.tmp.clear();
+            let mut w = 0;
+            for r in 0..n {
+                let id = list[r];
+                if self.left[id as usize] {
+                    list[w] = id;
+                    w += 1;
+                } else {
+                    self.tmp.push(id);
+                }
+            }
+            list[w..].copy_from_slice(&self.tmp);
+        }
+        let child = self.nodes.len();
+        self.nodes[at].first = child as u32;
+        self.nodes[at].meta = INNER | k as u32;
+        self.nodes.push(Node::default());
+        self.nodes.push(Node::default());
+        let [a, b, c] = parts;
+        let (al, ar) = a.split_at_mut(nl);
+        let (bl, br) = b.split_at_mut(nl);
+        let (cl, cr) = c.split_at_mut(nl);
+        self.build([al, bl, cl], child);
+        self.build([ar, br, cr], child + 1);
+    }
+}

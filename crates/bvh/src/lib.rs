@@ -16,6 +16,7 @@
 mod build;
 mod geometry;
 mod intersect;
+pub mod scenes;
 mod traverse;
 mod tree;
 

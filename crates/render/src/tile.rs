@@ -1,0 +1,272 @@
+//! Tiles, pixel blocks and the ball-and-stick shading kernel (paper §4.2 `renderTile`).
+
+use std::time::{Duration, Instant};
+
+use bvh::{surface, RayPacket};
+use rayon::prelude::*;
+use spmd::{Isa, Kernel, Simd, V3};
+
+use crate::camera::{Camera, Projection};
+use crate::framebuffer::{Framebuffer, RenderError};
+use crate::scene::Scene;
+
+/// Tile edge in pixels (tiles are the rayon tasks).
+pub const TILE: usize = 16;
+
+/// Shading options of the `b&s` mode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Background colour, packed RGBA8 (see [`crate::rgba`]).
+    pub background: u32,
+    /// Ambient term of the headlight shading: colour × (ambient + (1 − ambient)·|n·v|).
+    pub ambient: f32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            background: crate::rgba(255, 255, 255, 255),
+            ambient: 0.15,
+        }
+    }
+}
+
+/// What a render did.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderStats {
+    /// Backend used.
+    pub isa: Isa,
+    /// Wall time of the frame (tiles only, the framebuffer already allocated).
+    pub time: Duration,
+    /// Primary rays cast (one per pixel).
+    pub rays: u64,
+}
+
+impl RenderStats {
+    /// Million rays per second.
+    pub fn mrays_per_s(&self) -> f64 {
+        self.rays as f64 / self.time.as_secs_f64().max(1e-12) * 1e-6
+    }
+    /// Frames per second.
+    pub fn fps(&self) -> f64 {
+        1.0 / self.time.as_secs_f64().max(1e-12)
+    }
+}
+
+/// Renders `scene` as seen by `camera` into a new `width × height` frame: one primary ray per
+/// pixel, headlight diffuse shading. `isa` must be supported (see [`Isa::select`]).
+pub fn render_bs(
+    scene: &Scene,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    opt: &RenderOptions,
+    isa: Isa,
+) -> Result<(Framebuffer, RenderStats), RenderError> {
+    let mut fb = Framebuffer::new(width, height, opt.background)?;
+    let stats = render_bs_into(scene, camera, &mut fb, opt, isa);
+    Ok((fb, stats))
+}
+
+/// As [`render_bs`] into an existing frame (reuse it across frames).
+pub fn render_bs_into(
+    scene: &Scene,
+    camera: &Camera,
+    fb: &mut Framebuffer,
+    opt: &RenderOptions,
+    isa: Isa,
+) -> RenderStats {
+    let start = Instant::now();
+    let (w, h) = (fb.width as usize, fb.height as usize);
+    let view = ViewRays::new(camera, w, h);
+    let ntx = w.div_ceil(TILE);
+    if w > 0 && h > 0 {
+        fb.pixels
+            .par_chunks_mut(TILE * w)
+            .enumerate()
+            .for_each(|(ty, band)| {
+                // Each tile is a rayon task rendering into its own 16×16 buffer, then copied
+                // into the band (rows of the frame are not contiguous per tile).
+                let tiles: Vec<[u32; TILE * TILE]> = (0..ntx)
+                    .into_par_iter()
+                    .map(|tx| {
+                        let mut out = [0u32; TILE * TILE];
+                        isa.dispatch(TileKernel {
+                            scene,
+                            view: &view,
+                            opt,
+                            x0: tx * TILE,
+                            y0: ty * TILE,
+                            out: &mut out,
+                        });
+                        out
+                    })
+                    .collect();
+                let rows = band.len() / w;
+                for (tx, tile) in tiles.iter().enumerate() {
+                    let x0 = tx * TILE;
+                    let cols = TILE.min(w - x0);
+                    for r in 0..rows {
+                        band[r * w + x0..r * w + x0 + cols]
+                            .copy_from_slice(&tile[r * TILE..r * TILE + cols]);
+                    }
+                }
+            });
+    }
+    RenderStats {
+        isa,
+        time: start.elapsed(),
+        rays: (w * h) as u64,
+    }
+}
+
+/// Camera precomputed for a frame: ray of pixel (px, py) (pixel centres at +0.5) is
+/// `o = org + du·px + dv·py` (orthographic) or `d = normalize(dir0 + du·px + dv·py)`.
+struct ViewRays {
+    perspective: bool,
+    org: [f32; 3],
+    dir0: [f32; 3],
+    du: [f32; 3],
+    dv: [f32; 3],
+    width: f32,
+    height: f32,
+}
+
+impl ViewRays {
+    fn new(c: &Camera, w: usize, h: usize) -> ViewRays {
+        let (wf, hf) = (w.max(1) as f64, h.max(1) as f64);
+        let v = |a: [f32; 3], k: f64| [a[0] as f64 * k, a[1] as f64 * k, a[2] as f64 * k];
+        let add = |a: [f64; 3], b: [f64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+        let f32x3 = |a: [f64; 3]| [a[0] as f32, a[1] as f32, a[2] as f32];
+        match c.projection {
+            Projection::Perspective { fov_y_deg } => {
+                let ty = ((fov_y_deg as f64).to_radians() * 0.5).tan();
+                let tx = ty * wf / hf;
+                // Top-left corner direction, then per-pixel steps.
+                let corner = add(add(v(c.forward, 1.0), v(c.right, -tx)), v(c.up, ty));
+                ViewRays {
+                    perspective: true,
+                    org: c.eye,
+                    dir0: f32x3(corner),
+                    du: f32x3(v(c.right, 2.0 * tx / wf)),
+                    dv: f32x3(v(c.up, -2.0 * ty / hf)),
+                    width: w as f32,
+                    height: h as f32,
+                }
+            }
+            Projection::Orthographic { height } => {
+                let hh = height as f64 * 0.5;
+                let hw = hh * wf / hf;
+                let corner = add(add(v(c.eye, 1.0), v(c.right, -hw)), v(c.up, hh));
+                ViewRays {
+                    perspective: false,
+                    org: f32x3(corner),
+                    dir0: c.forward,
+                    du: f32x3(v(c.right, 2.0 * hw / wf)),
+                    dv: f32x3(v(c.up, -2.0 * hh / hf)),
+                    width: w as f32,
+                    height: h as f32,
+                }
+            }
+        }
+    }
+}
+
+struct TileKernel<'a> {
+    scene: &'a Scene,
+    view: &'a ViewRays,
+    opt: &'a RenderOptions,
+    x0: usize,
+    y0: usize,
+    out: &'a mut [u32; TILE * TILE],
+}
+
+/// Pixel block of a packet: `bw × bh = LANES`, as square as possible.
+const fn block_width(lanes: usize) -> usize {
+    match lanes {
+        1 => 1,
+        4 => 2,
+        8 => 4,
+        16 => 4,
+        _ => 1,
+    }
+}
+
+impl Kernel for TileKernel<'_> {
+    type Output = ();
+    /// Renders one 16×16 tile: pixel blocks of `LANES` primary rays, packet traversal (§4.3),
+    /// headlight diffuse shading (§4.5 "b&s").
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) {
+        let bvh = &self.scene.bvh;
+        let v = self.view;
+        let mut stack = vec![0u32; bvh.stack_size()];
+        let bw = block_width(S::LANES);
+        let bh = S::LANES / bw;
+        let mut lx = [0.0f32; spmd::MAX_LANES];
+        let mut ly = [0.0f32; spmd::MAX_LANES];
+        for i in 0..S::LANES {
+            lx[i] = (i % bw) as f32 + 0.5;
+            ly[i] = (i / bw) as f32 + 0.5;
+        }
+        let (lx, ly) = (s.load(&lx), s.load(&ly));
+        let zero = s.splat(0.0);
+        let ambient = s.splat(self.opt.ambient);
+        let diffuse = s.splat(1.0 - self.opt.ambient);
+        let bg = s.splat_i(self.opt.background as i32);
+        let mut px_buf = [0i32; spmd::MAX_LANES];
+        for by in (0..TILE).step_by(bh) {
+            for bx in (0..TILE).step_by(bw) {
+                let px = lx + s.splat((self.x0 + bx) as f32);
+                let py = ly + s.splat((self.y0 + by) as f32);
+                let active = s.lt(px, s.splat(v.width)) & s.lt(py, s.splat(v.height));
+                if s.none(active) {
+                    continue;
+                }
+                let du = V3::splat(s, v.du);
+                let dv = V3::splat(s, v.dv);
+                let step = du.scale(px) + dv.scale(py);
+                let (o, d) = if v.perspective {
+                    (
+                        V3::splat(s, v.org),
+                        (V3::splat(s, v.dir0) + step).normalize(s),
+                    )
+                } else {
+                    (V3::splat(s, v.org) + step, V3::splat(s, v.dir0))
+                };
+                let ray = RayPacket {
+                    o,
+                    d,
+                    tmin: zero,
+                    tmax: s.splat(f32::INFINITY),
+                    active,
+                };
+                let hit = bvh.traverse_packet(s, &ray, &mut stack);
+                let m = hit.hit_mask(s) & active;
+                let color = if s.any(m) {
+                    let srf = surface(s, &bvh.records, o, d, hit.t, hit.slot, m);
+                    let zi = s.splat_i(0);
+                    let ca = s.gather_i(&self.scene.slot_color_a, hit.slot, m, zi);
+                    let cb = s.gather_i(&self.scene.slot_color_b, hit.slot, m, zi);
+                    let c = s.select_i(srf.second_half, cb, ca);
+                    // Headlight: the light is at the eye, so the cosine is |n·d|.
+                    let shade = ambient + diffuse * s.abs(srf.n.dot(d));
+                    let ch = |shift: u32| {
+                        let k = s.to_f32(s.shr(c, shift) & s.splat_i(255));
+                        let v = s.min(s.max(k * shade + s.splat(0.5), zero), s.splat(255.0));
+                        s.shl(s.to_i32(v), shift)
+                    };
+                    let rgb = ch(0) | ch(8) | ch(16) | s.splat_i(0xff << 24);
+                    s.select_i(m, rgb, bg)
+                } else {
+                    bg
+                };
+                s.store_i(color, &mut px_buf);
+                for i in 0..S::LANES {
+                    let (x, y) = (bx + i % bw, by + i / bw);
+                    self.out[y * TILE + x] = px_buf[i] as u32;
+                }
+            }
+        }
+    }
+}

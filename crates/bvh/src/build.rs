@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use glam::Vec3A;
 use rayon::prelude::*;
 
 use crate::geometry::{prim_refs, Aabb, Geometry, PrimRef};
@@ -28,14 +29,59 @@ impl Default for BuildOptions {
     }
 }
 
+/// A box for the builder's inner loops (SSE min/max through glam).
+#[derive(Clone, Copy)]
+struct BBox {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl BBox {
+    const EMPTY: BBox = BBox {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+    };
+    #[inline(always)]
+    fn union(self, o: BBox) -> BBox {
+        BBox {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
+    }
+    #[inline(always)]
+    fn of(r: &PrimRef) -> BBox {
+        BBox {
+            lo: r.lo3(),
+            hi: r.hi3(),
+        }
+    }
+    #[inline(always)]
+    fn grow(&mut self, p: Vec3A) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+    /// Half the surface area (the factor 2 does not change any SAH decision); 0 if empty.
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+    fn aabb(&self) -> Aabb {
+        Aabb {
+            min: self.lo.into(),
+            max: self.hi.into(),
+        }
+    }
+}
+
 #[derive(Clone, Copy)]
 struct Bin {
-    b: Aabb,
+    b: BBox,
     n: u32,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    b: Aabb::EMPTY,
+    b: BBox::EMPTY,
     n: 0,
 };
 
@@ -44,8 +90,8 @@ type Bins = [[Bin; MAX_BINS]; 3];
 /// Where a primitive's (doubled) centroid falls along each axis.
 #[derive(Clone, Copy)]
 struct Binner {
-    min: [f32; 3],
-    scale: [f32; 3],
+    min: Vec3A,
+    scale: Vec3A,
     nb: usize,
 }
 
@@ -59,21 +105,31 @@ impl Binner {
             }
         }
         Binner {
-            min: cb.min,
-            scale,
+            min: cb.min.into(),
+            scale: scale.into(),
             nb,
         }
     }
+    /// Bin of `r` along every axis: `(c − min)·scale − ½`, clamped to `[0, nb − 1]` (NaN -> 0),
+    /// rounded to nearest by adding 2²³ and reading the low mantissa bits (no float-to-int
+    /// conversions). Binning and partitioning both use this, so they always agree.
     #[inline(always)]
-    fn bin(&self, r: &PrimRef, k: usize) -> usize {
-        // `as usize` saturates (NaN -> 0), the `min` keeps rounding at the top edge in range.
-        (((r.centroid2(k) - self.min[k]) * self.scale[k]) as usize).min(self.nb - 1)
+    fn bins(&self, r: &PrimRef) -> [usize; 3] {
+        const MAGIC: f32 = 8_388_608.0;
+        let f = (r.c2() - self.min) * self.scale - Vec3A::splat(0.5);
+        let f = f.max(Vec3A::ZERO).min(Vec3A::splat((self.nb - 1) as f32)) + Vec3A::splat(MAGIC);
+        [
+            (f.x.to_bits() & 0xff) as usize,
+            (f.y.to_bits() & 0xff) as usize,
+            (f.z.to_bits() & 0xff) as usize,
+        ]
     }
     fn fill(&self, refs: &[PrimRef], bins: &mut Bins) {
         for r in refs {
-            let b = r.aabb();
-            for (k, axis_bins) in bins.iter_mut().enumerate() {
-                let bin = &mut axis_bins[self.bin(r, k)];
+            let b = BBox::of(r);
+            let idx = self.bins(r);
+            for k in 0..3 {
+                let bin = &mut bins[k][idx[k]];
                 bin.b = bin.b.union(b);
                 bin.n += 1;
             }
@@ -101,10 +157,77 @@ struct Split {
     rcb: Aabb,
 }
 
+/// Nodes this small get an exact SAH sweep over sorted centroids instead of bins.
+const SMALL: usize = 16;
+
+/// Exact SAH split of a small node: sort along each axis, sweep, keep the best.
+fn split_small(refs: &mut [PrimRef]) -> Split {
+    let n = refs.len();
+    let mut best = (f32::INFINITY, 0usize, n / 2);
+    let mut order = [[0u8; SMALL]; 3];
+    let mut rcost = [0.0f32; SMALL];
+    let mut keys = [[0.0f32; SMALL]; 3];
+    for (i, r) in refs.iter().enumerate() {
+        let c = r.c2();
+        keys[0][i] = c.x;
+        keys[1][i] = c.y;
+        keys[2][i] = c.z;
+    }
+    for (k, ord) in order.iter_mut().enumerate() {
+        let ord = &mut ord[..n];
+        for (i, o) in ord.iter_mut().enumerate() {
+            *o = i as u8;
+        }
+        let key = &keys[k];
+        ord.sort_unstable_by(|&a, &b| key[a as usize].total_cmp(&key[b as usize]));
+        let mut acc = BBox::EMPTY;
+        for i in (1..n).rev() {
+            acc = acc.union(BBox::of(&refs[ord[i] as usize]));
+            rcost[i] = acc.half_area() * (n - i) as f32;
+        }
+        let mut acc = BBox::EMPTY;
+        for i in 1..n {
+            acc = acc.union(BBox::of(&refs[ord[i - 1] as usize]));
+            let cost = acc.half_area() * i as f32 + rcost[i];
+            if cost < best.0 {
+                best = (cost, k, i);
+            }
+        }
+    }
+    let (_, k, nl) = best;
+    let mut tmp = [refs[0]; SMALL];
+    for (t, &o) in tmp.iter_mut().zip(&order[k][..n]) {
+        *t = refs[o as usize];
+    }
+    refs.copy_from_slice(&tmp[..n]);
+    let side = |rs: &[PrimRef]| {
+        let mut b = BBox::EMPTY;
+        let mut cb = BBox::EMPTY;
+        for r in rs {
+            b = b.union(BBox::of(r));
+            cb.grow(r.c2());
+        }
+        (b.aabb(), cb.aabb())
+    };
+    let (lb, lcb) = side(&refs[..nl]);
+    let (rb, rcb) = side(&refs[nl..]);
+    Split {
+        axis: k as u32,
+        nl,
+        lb,
+        lcb,
+        rb,
+        rcb,
+    }
+}
+
 /// Finds the binned-SAH split of `refs` and partitions them in place.
 fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
     let n = refs.len();
-    let nb = nb.min(n).clamp(2, MAX_BINS);
+    if n <= SMALL {
+        return split_small(refs);
+    }
+    let nb = nb.clamp(2, MAX_BINS);
     let binner = Binner::new(cb, nb);
     let bins = if n >= PAR_BIN {
         refs.par_chunks(1 << 14)
@@ -130,15 +253,15 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
         }
         let mut rcost = [0.0f32; MAX_BINS];
         let mut rcount = [0u32; MAX_BINS];
-        let mut acc = Aabb::EMPTY;
+        let mut acc = BBox::EMPTY;
         let mut cnt = 0u32;
         for i in (1..nb).rev() {
             acc = acc.union(axis_bins[i].b);
             cnt += axis_bins[i].n;
-            rcost[i - 1] = acc.area() * cnt as f32;
+            rcost[i - 1] = acc.half_area() * cnt as f32;
             rcount[i - 1] = cnt;
         }
-        let mut acc = Aabb::EMPTY;
+        let mut acc = BBox::EMPTY;
         let mut cnt = 0u32;
         for i in 0..nb - 1 {
             acc = acc.union(axis_bins[i].b);
@@ -146,7 +269,7 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
             if cnt == 0 || rcount[i] == 0 {
                 continue;
             }
-            let cost = acc.area() * cnt as f32 + rcost[i];
+            let cost = acc.half_area() * cnt as f32 + rcost[i];
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, k, i));
             }
@@ -166,8 +289,8 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
             rcb: *cb,
         };
     };
-    let mut lb = Aabb::EMPTY;
-    let mut rb = Aabb::EMPTY;
+    let mut lb = BBox::EMPTY;
+    let mut rb = BBox::EMPTY;
     for (i, bin) in bins[k][..nb].iter().enumerate() {
         if i <= pos {
             lb = lb.union(bin.b);
@@ -177,16 +300,15 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
     }
     // Partition in place; every element is classified exactly once.
     let (mut i, mut j) = (0, n);
-    let mut lcb = Aabb::EMPTY;
-    let mut rcb = Aabb::EMPTY;
+    let mut lcb = BBox::EMPTY;
+    let mut rcb = BBox::EMPTY;
     while i < j {
         let r = refs[i];
-        let c = [r.centroid2(0), r.centroid2(1), r.centroid2(2)];
-        if binner.bin(&r, k) <= pos {
-            lcb.grow(c);
+        if binner.bins(&r)[k] <= pos {
+            lcb.grow(r.c2());
             i += 1;
         } else {
-            rcb.grow(c);
+            rcb.grow(r.c2());
             j -= 1;
             refs.swap(i, j);
         }
@@ -194,10 +316,10 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
     Split {
         axis: k as u32,
         nl: i,
-        lb,
-        lcb,
-        rb,
-        rcb,
+        lb: lb.aabb(),
+        lcb: lcb.aabb(),
+        rb: rb.aabb(),
+        rcb: rcb.aabb(),
     }
 }
 
@@ -297,7 +419,7 @@ impl Bvh {
             build_node(&mut refs, 0, bounds, cb, &mut root[0], region, 1, nb);
             compact(&slots)
         };
-        let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id).collect();
+        let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();
         Bvh::finish(g, nodes, order, Builder::Binned, start)
     }
 

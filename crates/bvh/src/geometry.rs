@@ -1,6 +1,7 @@
 //! Ball and stick primitives (paper §4.1 step 3): input arrays, per-primitive records used by
 //! the intersection kernels, and bounds + centroids computed in one parallel pass.
 
+use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
 /// Atoms drawn as balls, structure of arrays. Positions and radii in Ångström (Å).
@@ -343,32 +344,56 @@ impl Geometry {
     }
 }
 
-/// Primitive bounds, as the builders see them.
+/// Primitive bounds, as the builders see them: two SSE-friendly vectors, the primitive id
+/// tagged into both `w` lanes (as a normal/inf/NaN float, never a denormal, so arithmetic on
+/// the whole vector never hits slow paths).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PrimRef {
-    pub lo: [f32; 3],
-    pub id: u32,
-    pub hi: [f32; 3],
-    /// Padding (keeps the struct at 32 bytes).
-    pub _pad: u32,
+    pub lo: Vec4,
+    pub hi: Vec4,
 }
 
+const TAG: u32 = 0x4000_0000;
+/// Most primitives the builders handle (the id tag uses 30 bits).
+pub const MAX_PRIMS: usize = 1 << 30;
+
 impl PrimRef {
+    #[inline(always)]
+    pub fn new(b: &Aabb, id: u32) -> PrimRef {
+        let w = f32::from_bits(TAG | id);
+        PrimRef {
+            lo: Vec4::new(b.min[0], b.min[1], b.min[2], w),
+            hi: Vec4::new(b.max[0], b.max[1], b.max[2], w),
+        }
+    }
+    #[inline(always)]
+    pub fn id(&self) -> u32 {
+        self.lo.w.to_bits() & !TAG
+    }
+    #[inline(always)]
+    pub fn lo3(&self) -> Vec3A {
+        Vec3A::from_vec4(self.lo)
+    }
+    #[inline(always)]
+    pub fn hi3(&self) -> Vec3A {
+        Vec3A::from_vec4(self.hi)
+    }
     /// Twice the centroid (`lo + hi`), 0 for empty boxes.
     #[inline(always)]
+    pub fn c2(&self) -> Vec3A {
+        let c = self.lo3() + self.hi3();
+        Vec3A::select(c.is_finite_mask(), c, Vec3A::ZERO)
+    }
+    /// Twice the centroid along axis `k`.
+    #[inline(always)]
     pub fn centroid2(&self, k: usize) -> f32 {
-        let c = self.lo[k] + self.hi[k];
-        if c.is_finite() {
-            c
-        } else {
-            0.0
-        }
+        self.c2()[k]
     }
     #[inline(always)]
     pub fn aabb(&self) -> Aabb {
         Aabb {
-            min: self.lo,
-            max: self.hi,
+            min: self.lo3().into(),
+            max: self.hi3().into(),
         }
     }
 }
@@ -378,34 +403,33 @@ impl PrimRef {
 pub(crate) fn prim_refs(g: &Geometry) -> (Vec<PrimRef>, Aabb, Aabb) {
     const CHUNK: usize = 1 << 13;
     let n = g.prim_count();
-    let mut refs = vec![
-        PrimRef {
-            lo: [0.0; 3],
-            id: 0,
-            hi: [0.0; 3],
-            _pad: 0,
-        };
-        n
-    ];
+    assert!(n < MAX_PRIMS, "{n} primitives: at most 2^30 supported");
+    let mut refs = vec![PrimRef::new(&Aabb::EMPTY, 0); n];
     let (bounds, cbounds) = refs
         .par_chunks_mut(CHUNK)
         .enumerate()
         .map(|(ci, chunk)| {
-            let mut b = Aabb::EMPTY;
-            let mut cb = Aabb::EMPTY;
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            let (mut clo, mut chi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
             for (k, r) in chunk.iter_mut().enumerate() {
                 let id = (ci * CHUNK + k) as u32;
-                let pb = g.prim_bounds(id);
-                *r = PrimRef {
-                    lo: pb.min,
-                    id,
-                    hi: pb.max,
-                    _pad: 0,
-                };
-                b = b.union(pb);
-                cb.grow([r.centroid2(0), r.centroid2(1), r.centroid2(2)]);
+                *r = PrimRef::new(&g.prim_bounds(id), id);
+                lo = lo.min(r.lo3());
+                hi = hi.max(r.hi3());
+                let c = r.c2();
+                clo = clo.min(c);
+                chi = chi.max(c);
             }
-            (b, cb)
+            (
+                Aabb {
+                    min: lo.into(),
+                    max: hi.into(),
+                },
+                Aabb {
+                    min: clo.into(),
+                    max: chi.into(),
+                },
+            )
         })
         .reduce(
             || (Aabb::EMPTY, Aabb::EMPTY),

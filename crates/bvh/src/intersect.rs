@@ -64,6 +64,42 @@ pub fn ray_sphere<S: Simd>(
     pick(s, tn, hit, tf, hit, tmin, tmax)
 }
 
+/// Ray–hemisphere cap of a capsule (§4.3, licorice sticks): [`ray_sphere`] keeping only the
+/// roots on the outer side of the plane through `c` perpendicular to `axis`
+/// (`(p − c)·axis · side ≥ 0`, `side` = −1 at the first endpoint, +1 at the second), so rays
+/// from inside a capsule never stop at the part of a cap sphere inside the cylinder.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn ray_cap<S: Simd>(
+    s: S,
+    o: V3<S>,
+    d: V3<S>,
+    c: [f32; 3],
+    axis: [f32; 3],
+    side: f32,
+    r: f32,
+    tmin: S::F32,
+    tmax: S::F32,
+) -> (S::M, S::F32) {
+    let f = o - V3::splat(s, c);
+    let b = -f.dot(d);
+    let l = f.mul_add(d, b);
+    let r2 = s.splat(r * r);
+    let disc = r2 - l.dot(l);
+    let zero = s.splat(0.0);
+    let hit = s.ge(disc, zero);
+    let q = b + copysign(s, s.sqrt(s.max(disc, zero)), b);
+    let cc = f.dot(f) - r2;
+    let t0 = cc / q;
+    let tn = s.min(t0, q);
+    let tf = s.max(t0, q);
+    let ax = V3::splat(s, [axis[0] * side, axis[1] * side, axis[2] * side]);
+    let (fa, da) = (f.dot(ax), d.dot(ax));
+    let vn = hit & s.ge(fa + tn * da, zero);
+    let vf = hit & s.ge(fa + tf * da, zero);
+    pick(s, tn, vn, tf, vf, tmin, tmax)
+}
+
 /// Ray–cylinder, finite and open (§4.3; the stick of a bond): the quadratic is solved in the
 /// plane perpendicular to the axis with the same stable form as [`ray_sphere`]
 /// (`Δ = r² − |f⊥ − (b/a)d⊥|²`, `a = |d⊥|²` computed from the projected vector, not as
@@ -112,7 +148,7 @@ pub fn ray_cylinder<S: Simd>(
 }
 
 /// Intersects a packet with one primitive record (sphere, open cylinder, or capsule = cylinder
-/// with round caps when `capped`), narrowing `t` and recording `slot` where a lane hits nearer.
+/// with hemispherical caps when `capped`), narrowing `t` and recording `slot` where a lane hits nearer.
 /// Lanes off in `m` are untouched.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -143,8 +179,10 @@ pub fn intersect_record<S: Simd>(
     }
     if capped {
         let p1 = end_point(rec);
-        for c in [rec.p0, p1] {
-            let (h, th) = ray_sphere(s, o, d, c, rec.r, tmin, *t);
+        // Degenerate sticks (no axis) are capped by a whole sphere: both halves.
+        let ax = if rec.len > 0.0 { rec.axis } else { [0.0; 3] };
+        for (c, side) in [(rec.p0, -1.0), (p1, 1.0)] {
+            let (h, th) = ray_cap(s, o, d, c, ax, side, rec.r, tmin, *t);
             let h = h & m;
             *t = s.select(h, th, *t);
             *slot_hit = s.select_i(h, s.splat_i(slot), *slot_hit);

@@ -22,6 +22,8 @@ mod tree;
 
 pub use build::{BuildOptions, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
-pub use intersect::{end_point, intersect_record, ray_cylinder, ray_sphere, surface, Surface};
+pub use intersect::{
+    end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,
+};
 pub use traverse::{load_packet, unpack_hits, Hit, PacketHit, Ray, RayPacket};
 pub use tree::{BuildStats, Builder, Bvh, Node, INNER, LEAF_MAX};

@@ -188,6 +188,31 @@ impl Bvh {
         PacketHit { t, slot }
     }
 
+    /// Origin for a secondary ray leaving the hit `h` of `ray`: the hit point offset along the
+    /// normal, to the side the ray came from, by `64·ε·(max|p| + t + r)` Å — more than the
+    /// rounding error of the hit point and of the kernels, so a ray spawned there into that
+    /// hemisphere never re-hits the same surface (the pbrt rule).
+    pub fn spawn_point(&self, ray: &Ray, h: &Hit) -> [f32; 3] {
+        let p = [
+            ray.o[0] + ray.d[0] * h.t,
+            ray.o[1] + ray.d[1] * h.t,
+            ray.o[2] + ray.d[2] * h.t,
+        ];
+        let r = self.records[h.slot as usize].r;
+        let m = p.iter().fold(0.0f32, |a, v| a.max(v.abs()));
+        let off = 64.0 * f32::EPSILON * (m + h.t.abs() + r.abs());
+        let side = if h.n[0] * ray.d[0] + h.n[1] * ray.d[1] + h.n[2] * ray.d[2] > 0.0 {
+            -off
+        } else {
+            off
+        };
+        [
+            p[0] + h.n[0] * side,
+            p[1] + h.n[1] * side,
+            p[2] + h.n[2] * side,
+        ]
+    }
+
     /// Nearest hits of a packet by testing every primitive (reference for tests; O(n)).
     #[inline(always)]
     pub fn brute_packet<S: Simd>(&self, s: S, ray: &RayPacket<S>) -> PacketHit<S> {

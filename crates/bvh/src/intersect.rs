@@ -229,10 +229,18 @@ pub fn surface<S: Simd>(
     let flat: &[f32] = bytemuck::cast_slice(records);
     let base = s.shl(slot, 3);
     let zero = s.splat(0.0);
-    let g = |k: i32| s.gather(flat, base + s.splat_i(k), m, zero);
-    let p0 = V3::new(g(0), g(1), g(2));
-    let ax = V3::new(g(4), g(5), g(6));
-    let len = g(7);
+    // (No closures on the hot path: they would not inherit the entry point's target features.)
+    let p0 = V3::new(
+        gather_at(s, flat, base, 0, m),
+        gather_at(s, flat, base, 1, m),
+        gather_at(s, flat, base, 2, m),
+    );
+    let ax = V3::new(
+        gather_at(s, flat, base, 4, m),
+        gather_at(s, flat, base, 5, m),
+        gather_at(s, flat, base, 6, m),
+    );
+    let len = gather_at(s, flat, base, 7, m);
     let pr = (o - p0).mul_add(d, t);
     let lenc = s.max(len, zero);
     let along = s.min(s.max(pr.dot(ax), zero), lenc);
@@ -241,4 +249,9 @@ pub fn surface<S: Simd>(
         n,
         second_half: s.gt(along + along, lenc) & s.gt(lenc, zero),
     }
+}
+
+#[inline(always)]
+fn gather_at<S: Simd>(s: S, flat: &[f32], base: S::I32, k: i32, m: S::M) -> S::F32 {
+    s.gather(flat, base + s.splat_i(k), m, s.splat(0.0))
 }

@@ -256,6 +256,16 @@ impl Bvh {
         self.batch(isa, rays, true)
     }
 
+    /// Nearest hits of `rays` on the calling thread: one dispatch, packets in order
+    /// (`brute`: test every primitive instead of traversing). For benchmarks and tools.
+    pub fn intersect_chunk(&self, isa: Isa, rays: &[Ray], brute: bool) -> Vec<Option<Hit>> {
+        isa.dispatch(BatchKernel {
+            bvh: self,
+            rays,
+            brute,
+        })
+    }
+
     fn batch(&self, isa: Isa, rays: &[Ray], brute: bool) -> Vec<Option<Hit>> {
         rays.par_chunks(1024)
             .flat_map_iter(|chunk| {
@@ -331,23 +341,24 @@ pub fn unpack_hits<S: Simd>(
     let srf = surface(s, &bvh.records, p.o, p.d, h.t, h.slot, m);
     let bits = s.bitmask(m);
     let half = s.bitmask(srf.second_half);
-    (0..S::LANES)
-        .map(|i| {
-            if bits & (1 << i) == 0 {
-                return None;
-            }
-            let slot = s.extract_i(h.slot, i) as u32;
-            Some(Hit {
-                t: s.extract(h.t, i),
-                slot,
-                prim: bvh.prim_ids[slot as usize],
-                n: [
-                    s.extract(srf.n.x, i),
-                    s.extract(srf.n.y, i),
-                    s.extract(srf.n.z, i),
-                ],
-                second_half: half & (1 << i) != 0,
-            })
-        })
-        .collect()
+    let mut out = Vec::with_capacity(S::LANES);
+    for i in 0..S::LANES {
+        if bits & (1 << i) == 0 {
+            out.push(None);
+            continue;
+        }
+        let slot = s.extract_i(h.slot, i) as u32;
+        out.push(Some(Hit {
+            t: s.extract(h.t, i),
+            slot,
+            prim: bvh.prim_ids[slot as usize],
+            n: [
+                s.extract(srf.n.x, i),
+                s.extract(srf.n.y, i),
+                s.extract(srf.n.z, i),
+            ],
+            second_half: half & (1 << i) != 0,
+        }));
+    }
+    out
 }

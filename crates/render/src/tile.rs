@@ -251,12 +251,10 @@ impl Kernel for TileKernel<'_> {
                     let c = s.select_i(srf.second_half, cb, ca);
                     // Headlight: the light is at the eye, so the cosine is |n·d|.
                     let shade = ambient + diffuse * s.abs(srf.n.dot(d));
-                    let ch = |shift: u32| {
-                        let k = s.to_f32(s.shr(c, shift) & s.splat_i(255));
-                        let v = s.min(s.max(k * shade + s.splat(0.5), zero), s.splat(255.0));
-                        s.shl(s.to_i32(v), shift)
-                    };
-                    let rgb = ch(0) | ch(8) | ch(16) | s.splat_i(0xff << 24);
+                    let rgb = channel(s, c, 0, shade)
+                        | channel(s, c, 8, shade)
+                        | channel(s, c, 16, shade)
+                        | s.splat_i(0xff << 24);
                     s.select_i(m, rgb, bg)
                 } else {
                     bg
@@ -269,4 +267,16 @@ impl Kernel for TileKernel<'_> {
             }
         }
     }
+}
+
+/// One 8-bit channel of packed colours `c` at bit `shift`, scaled by `shade` and rounded.
+/// (A function, not a closure: closures would not inherit the entry point's target features.)
+#[inline(always)]
+fn channel<S: Simd>(s: S, c: S::I32, shift: u32, shade: S::F32) -> S::I32 {
+    let k = s.to_f32(s.shr(c, shift) & s.splat_i(255));
+    let v = s.min(
+        s.max(k * shade + s.splat(0.5), s.splat(0.0)),
+        s.splat(255.0),
+    );
+    s.shl(s.to_i32(v), shift)
 }

@@ -105,66 +105,86 @@ impl Bvh {
         ray: &RayPacket<S>,
         stack: &mut [u32],
     ) -> PacketHit<S> {
+        let [h] =
+            self.traverse_packets::<S, 1>(s, std::slice::from_ref(ray).try_into().unwrap(), stack);
+        h
+    }
+
+    /// [`Bvh::traverse_packet`] for a packet of `N` registers (`N × LANES` rays): a node is
+    /// entered when any ray of any register hits it; at leaves each register with a ray in
+    /// the leaf box is tested. Amortises the uniform traversal work over more rays.
+    #[inline(always)]
+    pub fn traverse_packets<S: Simd, const N: usize>(
+        &self,
+        s: S,
+        rays: &[RayPacket<S>; N],
+        stack: &mut [u32],
+    ) -> [PacketHit<S>; N] {
         let nodes = &self.nodes[..];
         let records = &self.records[..];
         let capped = self.capped;
-        let o = ray.o;
-        let d = ray.d;
-        let inv = V3::<S>::new(s.rcp(d.x), s.rcp(d.y), s.rcp(d.z));
-        // Inactive lanes get t = −∞ so no box test passes for them.
-        let mut t = s.select(ray.active, ray.tmax, s.splat(f32::NEG_INFINITY));
-        let mut slot = s.splat_i(-1);
-        let tmin = ray.tmin;
+        // (Loops, not `array::from_fn` closures: closures may not inherit target features.)
+        let mut inv = [V3::splat(s, [0.0; 3]); N];
+        let mut hits = [PacketHit {
+            t: s.splat(0.0),
+            slot: s.splat_i(-1),
+        }; N];
+        for j in 0..N {
+            let d = rays[j].d;
+            inv[j] = V3::new(s.rcp(d.x), s.rcp(d.y), s.rcp(d.z));
+            // Inactive lanes get t = −∞ so no box test passes for them.
+            hits[j].t = s.select(rays[j].active, rays[j].tmax, s.splat(f32::NEG_INFINITY));
+        }
         // Box exits are inflated by 1 + 2γ₃ (pbrt) so rounding never loses a box the ray hits.
         let grow =
             s.splat(1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5));
-        let bits = s.bitmask(ray.active);
-        if bits == 0 || nodes.is_empty() {
-            return PacketHit { t, slot };
+        let mut first = N;
+        for j in (0..N).rev() {
+            if s.any(rays[j].active) {
+                first = j;
+            }
         }
-        let lane = bits.trailing_zeros() as usize;
+        if first == N || nodes.is_empty() {
+            return hits;
+        }
+        let lane = s.bitmask(rays[first].active).trailing_zeros() as usize;
+        let d0 = rays[first].d;
         let neg = [
-            s.extract(d.x, lane) < 0.0,
-            s.extract(d.y, lane) < 0.0,
-            s.extract(d.z, lane) < 0.0,
+            s.extract(d0.x, lane) < 0.0,
+            s.extract(d0.y, lane) < 0.0,
+            s.extract(d0.z, lane) < 0.0,
         ];
         let mut sp = 0usize;
         let mut idx = 0usize;
+        let mut masks = [s.splat_m(false); N];
         loop {
             let node = &nodes[idx];
-            // Slab test: entry = max(t_lo) over axes and tmin, exit = min(t_hi) and current t.
-            // `min`/`max` drop a NaN first operand (0·∞ for a ray in a slab plane).
-            let tx0 = (s.splat(node.min[0]) - o.x) * inv.x;
-            let tx1 = (s.splat(node.max[0]) - o.x) * inv.x;
-            let ty0 = (s.splat(node.min[1]) - o.y) * inv.y;
-            let ty1 = (s.splat(node.max[1]) - o.y) * inv.y;
-            let tz0 = (s.splat(node.min[2]) - o.z) * inv.z;
-            let tz1 = (s.splat(node.max[2]) - o.z) * inv.z;
-            let entry = s.max(
-                s.min(tx0, tx1),
-                s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), tmin)),
-            );
-            let exit = s.min(
-                s.max(tx0, tx1),
-                s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), t)),
-            );
-            let m = s.le(entry, exit * grow) & s.le(entry, t);
-            if s.any(m) {
+            let mut any = false;
+            for j in 0..N {
+                masks[j] = box_test(s, node, &rays[j], &inv[j], hits[j].t, grow);
+                any |= s.any(masks[j]);
+            }
+            if any {
                 if node.is_leaf() {
                     let first = node.first as usize;
                     for (k, rec) in records[first..first + node.count()].iter().enumerate() {
-                        intersect_record(
-                            s,
-                            o,
-                            d,
-                            rec,
-                            capped,
-                            tmin,
-                            &mut t,
-                            &mut slot,
-                            (first + k) as i32,
-                            m,
-                        );
+                        for j in 0..N {
+                            if N > 1 && s.none(masks[j]) {
+                                continue;
+                            }
+                            intersect_record(
+                                s,
+                                rays[j].o,
+                                rays[j].d,
+                                rec,
+                                capped,
+                                rays[j].tmin,
+                                &mut hits[j].t,
+                                &mut hits[j].slot,
+                                (first + k) as i32,
+                                masks[j],
+                            );
+                        }
                     }
                 } else {
                     let c = node.first as usize;
@@ -185,7 +205,7 @@ impl Bvh {
             sp -= 1;
             idx = stack[sp] as usize;
         }
-        PacketHit { t, slot }
+        hits
     }
 
     /// Origin for a secondary ray leaving the hit `h` of `ray`: the hit point offset along the
@@ -361,4 +381,34 @@ pub fn unpack_hits<S: Simd>(
         }));
     }
     out
+}
+
+/// Slab test of one node against a packet: lanes whose ray enters the box before its current
+/// hit `t`. `min`/`max` drop a NaN first operand (0·∞ for a ray in a slab plane); the exit is
+/// inflated by `grow` so rounding never loses a box.
+#[inline(always)]
+fn box_test<S: Simd>(
+    s: S,
+    node: &crate::tree::Node,
+    ray: &RayPacket<S>,
+    inv: &V3<S>,
+    t: S::F32,
+    grow: S::F32,
+) -> S::M {
+    let o = ray.o;
+    let tx0 = (s.splat(node.min[0]) - o.x) * inv.x;
+    let tx1 = (s.splat(node.max[0]) - o.x) * inv.x;
+    let ty0 = (s.splat(node.min[1]) - o.y) * inv.y;
+    let ty1 = (s.splat(node.max[1]) - o.y) * inv.y;
+    let tz0 = (s.splat(node.min[2]) - o.z) * inv.z;
+    let tz1 = (s.splat(node.max[2]) - o.z) * inv.z;
+    let entry = s.max(
+        s.min(tx0, tx1),
+        s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), ray.tmin)),
+    );
+    let exit = s.min(
+        s.max(tx0, tx1),
+        s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), t)),
+    );
+    s.le(entry, exit * grow) & s.le(entry, t)
 }

@@ -175,6 +175,7 @@ fn analytic_shading_orthographic() {
     let ro = RenderOptions {
         background: rgba(0, 0, 0, 255),
         ambient: 0.2,
+        ..Default::default()
     };
     for isa in Isa::supported() {
         let (fb, _) = render_bs(&scene, &cam, w, h, &ro, isa).unwrap();

@@ -198,6 +198,7 @@ impl Bvh {
                 if c == 0 || c > LEAF_MAX || f + c > n {
                     return Err(format!("leaf {i}: bad range {f}+{c}"));
                 }
+                #[allow(clippy::needless_range_loop)] // indexes three arrays by slot
                 for s in f..f + c {
                     if seen_slot[s] {
                         return Err(format!("slot {s} in two leaves"));

@@ -1,11 +1,10 @@
-//! Times the binned builder: `cargo run --release -p bvh --example build_time -- [atoms]`.
+//! Times the binned builder: `cargo run --release -p bvh --example build_time -- [atoms] [reps]`.
 fn main() {
-    let n: usize = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(500_000);
+    let a: Vec<String> = std::env::args().collect();
+    let n: usize = a.get(1).and_then(|a| a.parse().ok()).unwrap_or(500_000);
+    let reps: usize = a.get(2).and_then(|a| a.parse().ok()).unwrap_or(5);
     let g = bvh::scenes::random_molecule(n, false, 7);
-    for _ in 0..5 {
+    for _ in 0..reps {
         let b = bvh::Bvh::build(&g);
         println!(
             "{} prims: {:.1} ms = {:.2} M prims/s, SAH {:.2}",

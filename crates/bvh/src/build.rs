@@ -178,8 +178,18 @@ fn split_small(refs: &mut [PrimRef]) -> Split {
         for (i, o) in ord.iter_mut().enumerate() {
             *o = i as u8;
         }
+        // Insertion sort by key (n <= 16; NaN-free: centroids are sanitised to finite values).
         let key = &keys[k];
-        ord.sort_unstable_by(|&a, &b| key[a as usize].total_cmp(&key[b as usize]));
+        for i in 1..n {
+            let v = ord[i];
+            let kv = key[v as usize];
+            let mut j = i;
+            while j > 0 && key[ord[j - 1] as usize] > kv {
+                ord[j] = ord[j - 1];
+                j -= 1;
+            }
+            ord[j] = v;
+        }
         let mut acc = BBox::EMPTY;
         for i in (1..n).rev() {
             acc = acc.union(BBox::of(&refs[ord[i] as usize]));
@@ -221,7 +231,8 @@ fn split_small(refs: &mut [PrimRef]) -> Split {
     }
 }
 
-/// Finds the binned-SAH split of `refs` and partitions them in place.
+/// Binned SAH split (§4.1 step 4, binned after Wald 2007): bins centroids along x, y and z,
+/// sweeps the bins, and partitions `refs` in place.
 fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
     let n = refs.len();
     if n <= SMALL {
@@ -400,7 +411,7 @@ fn compact(slots: &[Node]) -> Vec<Node> {
 
 impl Bvh {
     /// Binned SAH build with default options (32 bins, ≤ 4 primitives per leaf), parallel over
-    /// subtrees on the current rayon pool.
+    /// subtrees on the current rayon pool. Panics beyond 2³⁰ primitives.
     pub fn build(g: &Geometry) -> Bvh {
         Bvh::build_with(g, &BuildOptions::default())
     }

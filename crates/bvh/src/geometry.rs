@@ -202,6 +202,7 @@ impl Geometry {
     /// (packed RGBA8, see [`Balls::color`]), bond pairs and a stick radius (Å).
     ///
     /// Bonds naming an atom that does not exist are dropped (never a panic later on).
+    /// Panics if `x`, `y`, `z`, `radius` (and a non-empty `color`) differ in length.
     pub fn from_atoms(
         x: &[f32],
         y: &[f32],

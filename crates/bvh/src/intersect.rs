@@ -147,7 +147,7 @@ pub fn ray_cylinder<S: Simd>(
     pick(s, tn, vn, tf, vf, tmin, tmax)
 }
 
-/// Intersects a packet with one primitive record (sphere, open cylinder, or capsule = cylinder
+/// Leaf test (§4.3): intersects a packet with one primitive record (sphere, open cylinder, or capsule = cylinder
 /// with hemispherical caps when `capped`), narrowing `t` and recording `slot` where a lane hits nearer.
 /// Lanes off in `m` are untouched.
 #[inline(always)]

@@ -383,7 +383,7 @@ pub fn unpack_hits<S: Simd>(
     out
 }
 
-/// Slab test of one node against a packet: lanes whose ray enters the box before its current
+/// Ray–box slab test (§4.3 traversal) of one node against a packet: lanes whose ray enters the box before its current
 /// hit `t`. `min`/`max` drop a NaN first operand (0·∞ for a ray in a slab plane); the exit is
 /// inflated by `grow` so rounding never loses a box.
 #[inline(always)]

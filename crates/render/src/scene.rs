@@ -77,7 +77,8 @@ pub struct Scene {
 impl Scene {
     /// Builds a scene from atom positions (Å), per-atom base radius (Å, scaled by
     /// `opt.radius_scale`), per-atom colours (packed RGBA8, see [`crate::rgba`]) and bonds.
-    /// Bonds with an atom index out of range are ignored.
+    /// Bonds with an atom index out of range are ignored. `colors` may be empty (grey).
+    /// Panics if `x`, `y`, `z` and `radius` differ in length.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         x: &[f32],

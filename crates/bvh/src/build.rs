@@ -231,16 +231,16 @@ fn split_small(refs: &mut [PrimRef]) -> Split {
     }
 }
 
-/// Binned SAH split (§4.1 step 4, binned after Wald 2007): bins centroids along x, y and z,
-/// sweeps the bins, and partitions `refs` in place.
-fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
-    let n = refs.len();
-    if n <= SMALL {
-        return split_small(refs);
-    }
-    let nb = nb.clamp(2, MAX_BINS);
-    let binner = Binner::new(cb, nb);
-    let bins = if n >= PAR_BIN {
+/// Bins ready for a node: the binner they were made with and the bins.
+#[derive(Clone, Copy)]
+struct Binned {
+    binner: Binner,
+    bins: Bins,
+}
+
+/// Bins of `refs` (in parallel for large runs).
+fn compute_bins(refs: &[PrimRef], binner: &Binner) -> Bins {
+    if refs.len() >= PAR_BIN {
         refs.par_chunks(1 << 14)
             .fold(
                 || [[EMPTY_BIN; MAX_BINS]; 3],
@@ -254,7 +254,41 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
         let mut b = [[EMPTY_BIN; MAX_BINS]; 3];
         binner.fill(refs, &mut b);
         b
-    };
+    }
+}
+
+#[inline(always)]
+fn add_to(bins: &mut Bins, idx: [usize; 3], b: BBox) {
+    for (k, axis_bins) in bins.iter_mut().enumerate() {
+        let bin = &mut axis_bins[idx[k]];
+        bin.b = bin.b.union(b);
+        bin.n += 1;
+    }
+}
+
+/// Binned SAH split (§4.1 step 4, binned after Wald 2007): bins centroids along x, y and z
+/// (or takes the bins the parent made), sweeps the bins, and partitions `refs` in place.
+/// The partition pass also bins each child's primitives (with the child's centroid range
+/// estimated from the split plane), so every level reads the primitives once, not twice.
+fn split(
+    refs: &mut [PrimRef],
+    cb: &Aabb,
+    nb: usize,
+    pre: Option<Box<Binned>>,
+) -> (Split, Option<Box<Binned>>, Option<Box<Binned>>) {
+    let n = refs.len();
+    if n <= SMALL {
+        return (split_small(refs), None, None);
+    }
+    let mut pre = pre.unwrap_or_else(|| {
+        let binner = Binner::new(cb, nb.clamp(2, MAX_BINS));
+        Box::new(Binned {
+            binner,
+            bins: compute_bins(refs, &binner),
+        })
+    });
+    let (binner, bins) = (pre.binner, &pre.bins);
+    let nb = binner.nb;
 
     // Sweep: cost of splitting after bin i = A(left)·N(left) + A(right)·N(right).
     let mut best: Option<(f32, usize, usize)> = None;
@@ -291,7 +325,7 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
         // Every centroid in the same place: split the run in the middle.
         let nl = n / 2;
         let (l, r) = refs.split_at(nl);
-        return Split {
+        let s = Split {
             axis: 0,
             nl,
             lb: refs_bounds(l),
@@ -299,6 +333,7 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
             rb: refs_bounds(r),
             rcb: *cb,
         };
+        return (s, None, None);
     };
     let mut lb = BBox::EMPTY;
     let mut rb = BBox::EMPTY;
@@ -309,35 +344,55 @@ fn split(refs: &mut [PrimRef], cb: &Aabb, nb: usize) -> Split {
             rb = rb.union(bin.b);
         }
     }
-    // Partition in place; every element is classified exactly once.
+    // Children's centroid ranges, estimated: the parent's, cut at the split plane.
+    let plane = binner.min[k] + (pos + 1) as f32 / binner.scale[k];
+    let (mut lcb_est, mut rcb_est) = (*cb, *cb);
+    lcb_est.max[k] = plane.min(cb.max[k]);
+    rcb_est.min[k] = plane.max(cb.min[k]);
+    let (lbinner, rbinner) = (Binner::new(&lcb_est, nb), Binner::new(&rcb_est, nb));
+    // The parent's bins are no longer needed: reuse their box for the left child.
+    pre.binner = lbinner;
+    pre.bins = [[EMPTY_BIN; MAX_BINS]; 3];
+    let mut lpre = pre;
+    let mut rpre = Box::new(Binned {
+        binner: rbinner,
+        bins: [[EMPTY_BIN; MAX_BINS]; 3],
+    });
+    let (lbins, rbins) = (&mut lpre.bins, &mut rpre.bins);
+    // Partition in place; every element is classified (and binned for its child) once.
     let (mut i, mut j) = (0, n);
     let mut lcb = BBox::EMPTY;
     let mut rcb = BBox::EMPTY;
     while i < j {
         let r = refs[i];
+        let c = r.c2();
         if binner.bins(&r)[k] <= pos {
-            lcb.grow(r.c2());
+            lcb.grow(c);
+            add_to(lbins, lbinner.bins(&r), BBox::of(&r));
             i += 1;
         } else {
-            rcb.grow(r.c2());
+            rcb.grow(c);
+            add_to(rbins, rbinner.bins(&r), BBox::of(&r));
             j -= 1;
             refs.swap(i, j);
         }
     }
-    Split {
+    let s = Split {
         axis: k as u32,
         nl: i,
         lb: lb.aabb(),
         lcb: lcb.aabb(),
         rb: rb.aabb(),
         rcb: rcb.aabb(),
-    }
+    };
+    (s, Some(lpre), Some(rpre))
 }
 
 /// Builds the subtree of `refs` under `node`. `region` (global index `region_base`) receives
 /// all descendants; it has room for `2·n − 2` nodes, which is enough for any binary tree with
 /// at least one primitive per leaf. Children pairs come first, then the left descendants'
-/// region, then the right's. Unused slots are dropped by [`compact`].
+/// region, then the right's. Unused slots are dropped by [`compact`]. `pre`: bins of `refs`
+/// made by the parent's partition pass.
 #[allow(clippy::too_many_arguments)]
 fn build_node<'a>(
     mut refs: &'a mut [PrimRef],
@@ -348,6 +403,7 @@ fn build_node<'a>(
     mut region: &'a mut [Node],
     mut region_base: usize,
     nb: usize,
+    mut pre: Option<Box<Binned>>,
 ) {
     loop {
         node.set_aabb(&bounds);
@@ -357,7 +413,7 @@ fn build_node<'a>(
             node.meta = n as u32;
             return;
         }
-        let s = split(refs, &cb, nb);
+        let (s, lpre, rpre) = split(refs, &cb, nb, pre);
         let (nl, nr) = (s.nl, n - s.nl);
         node.first = region_base as u32;
         node.meta = INNER | s.axis;
@@ -370,20 +426,20 @@ fn build_node<'a>(
         let (lref_base, rref_base) = (ref_base, ref_base + nl);
         if nl >= PAR_SUBTREE && nr >= PAR_SUBTREE {
             rayon::join(
-                || build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb),
-                || build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb),
+                || build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb, lpre),
+                || build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb, rpre),
             );
             return;
         }
         // Recurse into the smaller side, loop on the larger: stack depth stays O(log n).
         if nl <= nr {
-            build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb);
-            (refs, ref_base, bounds, cb, node, region, region_base) =
-                (rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase);
+            build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb, lpre);
+            (refs, ref_base, bounds, cb, node, region, region_base, pre) =
+                (rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, rpre);
         } else {
-            build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb);
-            (refs, ref_base, bounds, cb, node, region, region_base) =
-                (lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase);
+            build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb, rpre);
+            (refs, ref_base, bounds, cb, node, region, region_base, pre) =
+                (lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, lpre);
         }
     }
 }
@@ -427,7 +483,7 @@ impl Bvh {
         } else {
             let mut slots = vec![Node::default(); 2 * n - 1];
             let (root, region) = slots.split_at_mut(1);
-            build_node(&mut refs, 0, bounds, cb, &mut root[0], region, 1, nb);
+            build_node(&mut refs, 0, bounds, cb, &mut root[0], region, 1, nb, None);
             compact(&slots)
         };
         let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();

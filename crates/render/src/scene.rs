@@ -153,17 +153,37 @@ impl Scene {
                 Prim::Stick(j) => (color(g.sticks.a[j as usize]), color(g.sticks.b[j as usize])),
             })
             .unzip();
+        // Bounding sphere: centre of the box, radius to the farthest ball surface (tighter than
+        // the box's half diagonal, so the far view is filled as well as it can be).
         let b = bvh.bounds;
         let (center, radius) = if b.is_empty() {
             ([0.0; 3], 1.0)
         } else {
             let c = b.center();
-            let r = (0..3)
-                .map(|k| (b.max[k] - b.min[k]) as f64 * 0.5)
-                .map(|h| h * h)
-                .sum::<f64>()
-                .sqrt() as f32;
-            (c, r)
+            let extra = g.sticks.radius.max(0.0);
+            let r = (0..g.balls.len())
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|i| {
+                    let d = [
+                        (g.balls.x[i] - c[0]) as f64,
+                        (g.balls.y[i] - c[1]) as f64,
+                        (g.balls.z[i] - c[2]) as f64,
+                    ];
+                    let rb = if g.show_balls {
+                        g.balls.radius[i].max(extra)
+                    } else {
+                        extra
+                    };
+                    let v = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() + rb as f64;
+                    if v.is_finite() {
+                        v
+                    } else {
+                        0.0
+                    }
+                })
+                .reduce(|| 0.0, f64::max) as f32;
+            (c, r.max(1e-3))
         };
         Scene {
             geometry: g,

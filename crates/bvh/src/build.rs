@@ -402,81 +402,140 @@ fn split(
     (s, Some(lpre), Some(rpre))
 }
 
-/// Builds the subtree of `refs` under `node`. `region` (global index `region_base`) receives
-/// all descendants; it has room for `2·n − 2` nodes, which is enough for any binary tree with
-/// at least one primitive per leaf. Children pairs come first, then the left descendants'
-/// region, then the right's. Unused slots are dropped by [`compact`]. `pre`: bins of `refs`
-/// made by the parent's partition pass.
+/// The top of the tree, built in parallel: inner nodes down to subtrees small enough to build
+/// sequentially, each into its own exactly sized node array.
+enum Skeleton {
+    Inner {
+        bounds: Aabb,
+        axis: u32,
+        children: Box<(Skeleton, Skeleton)>,
+    },
+    /// A subtree: root at 0, children pairs adjacent, indices local to the array; leaves
+    /// hold global primitive slots.
+    Local(Vec<Node>),
+}
+
+/// Builds the tree over `refs` (primitive slots from `ref_base`): rayon over subtrees while
+/// both sides have at least [`PAR_SUBTREE`] primitives, then sequentially.
+fn build_skeleton(
+    refs: &mut [PrimRef],
+    ref_base: usize,
+    bounds: Aabb,
+    cb: Aabb,
+    nb: usize,
+    pre: Option<Box<Binned>>,
+) -> Skeleton {
+    let n = refs.len();
+    if n >= 2 * PAR_SUBTREE {
+        let (s, lpre, rpre) = split(refs, &cb, nb, pre);
+        let nl = s.nl;
+        let (lrefs, rrefs) = refs.split_at_mut(nl);
+        if nl >= PAR_SUBTREE && n - nl >= PAR_SUBTREE {
+            let (l, r) = rayon::join(
+                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, nb, lpre),
+                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre),
+            );
+            return Skeleton::Inner {
+                bounds,
+                axis: s.axis,
+                children: Box::new((l, r)),
+            };
+        }
+        // Too lopsided to fork: the split is done, build both sides here.
+        let mut nodes = Vec::with_capacity(n);
+        let mut root = Node::default();
+        root.set_aabb(&bounds);
+        root.first = 1;
+        root.meta = INNER | s.axis;
+        nodes.extend([root, Node::default(), Node::default()]);
+        build_seq(lrefs, ref_base, s.lb, s.lcb, nb, lpre, &mut nodes, 1);
+        build_seq(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, &mut nodes, 2);
+        return Skeleton::Local(nodes);
+    }
+    let mut nodes = Vec::with_capacity(n);
+    nodes.push(Node::default());
+    build_seq(refs, ref_base, bounds, cb, nb, pre, &mut nodes, 0);
+    Skeleton::Local(nodes)
+}
+
+/// Sequential build of the subtree of `refs` into `nodes[at]` (children pairs pushed at the
+/// end). Recurses into the smaller child and loops on the larger: stack depth O(log n).
 #[allow(clippy::too_many_arguments)]
-fn build_node<'a>(
-    mut refs: &'a mut [PrimRef],
+fn build_seq(
+    mut refs: &mut [PrimRef],
     mut ref_base: usize,
     mut bounds: Aabb,
     mut cb: Aabb,
-    mut node: &'a mut Node,
-    mut region: &'a mut [Node],
-    mut region_base: usize,
     nb: usize,
     mut pre: Option<Box<Binned>>,
+    nodes: &mut Vec<Node>,
+    mut at: usize,
 ) {
     loop {
-        node.set_aabb(&bounds);
+        nodes[at].set_aabb(&bounds);
         let n = refs.len();
         if n <= LEAF_MAX {
-            node.first = ref_base as u32;
-            node.meta = n as u32;
+            nodes[at].first = ref_base as u32;
+            nodes[at].meta = n as u32;
             return;
         }
         let (s, lpre, rpre) = split(refs, &cb, nb, pre);
         let (nl, nr) = (s.nl, n - s.nl);
-        node.first = region_base as u32;
-        node.meta = INNER | s.axis;
-        let (pair, rest) = std::mem::take(&mut region).split_at_mut(2);
-        let (lreg, rreg) = rest.split_at_mut(2 * nl - 2);
+        let c = nodes.len();
+        nodes[at].first = c as u32;
+        nodes[at].meta = INNER | s.axis;
+        nodes.push(Node::default());
+        nodes.push(Node::default());
         let (lrefs, rrefs) = std::mem::take(&mut refs).split_at_mut(nl);
-        let (lnode, rnode) = pair.split_at_mut(1);
-        let (lnode, rnode) = (&mut lnode[0], &mut rnode[0]);
-        let (lbase, rbase) = (region_base + 2, region_base + 2 * nl);
-        let (lref_base, rref_base) = (ref_base, ref_base + nl);
-        if nl >= PAR_SUBTREE && nr >= PAR_SUBTREE {
-            rayon::join(
-                || build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb, lpre),
-                || build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb, rpre),
-            );
-            return;
-        }
-        // Recurse into the smaller side, loop on the larger: stack depth stays O(log n).
         if nl <= nr {
-            build_node(lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, nb, lpre);
-            (refs, ref_base, bounds, cb, node, region, region_base, pre) =
-                (rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, rpre);
+            build_seq(lrefs, ref_base, s.lb, s.lcb, nb, lpre, nodes, c);
+            (refs, ref_base, bounds, cb, pre, at) =
+                (rrefs, ref_base + nl, s.rb, s.rcb, rpre, c + 1);
         } else {
-            build_node(rrefs, rref_base, s.rb, s.rcb, rnode, rreg, rbase, nb, rpre);
-            (refs, ref_base, bounds, cb, node, region, region_base, pre) =
-                (lrefs, lref_base, s.lb, s.lcb, lnode, lreg, lbase, lpre);
+            build_seq(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, nodes, c + 1);
+            (refs, ref_base, bounds, cb, pre, at) = (lrefs, ref_base, s.lb, s.lcb, lpre, c);
         }
     }
 }
 
-/// Copies the reachable nodes of a sparse slot array into a dense one (depth first, children
-/// pairs kept adjacent).
-fn compact(slots: &[Node]) -> Vec<Node> {
-    let mut out = Vec::with_capacity(slots.len() / 2 + 1);
-    out.push(slots[0]);
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((old, new)) = stack.pop() {
-        let n = slots[old];
-        if n.is_leaf() {
-            continue;
-        }
-        let c = out.len();
-        out.push(slots[n.first as usize]);
-        out.push(slots[n.first as usize + 1]);
-        out[new].first = c as u32;
-        stack.push((n.first as usize + 1, c + 1));
-        stack.push((n.first as usize, c));
-    }
+/// Flattens a skeleton into one node array (root at 0, children pairs adjacent).
+fn assemble(sk: Skeleton, prims: usize) -> Vec<Node> {
+    let mut out = Vec::with_capacity(prims / 2 + 8);
+    out.push(Node::default());
+    place(sk, 0, &mut out);
     out
+}
+
+fn place(sk: Skeleton, at: usize, out: &mut Vec<Node>) {
+    match sk {
+        Skeleton::Inner {
+            bounds,
+            axis,
+            children,
+        } => {
+            let c = out.len();
+            out[at].set_aabb(&bounds);
+            out[at].first = c as u32;
+            out[at].meta = INNER | axis;
+            out.push(Node::default());
+            out.push(Node::default());
+            let (l, r) = *children;
+            place(l, c, out);
+            place(r, c + 1, out);
+        }
+        Skeleton::Local(v) => {
+            // Local index i >= 1 goes to base + i - 1; the local root to `at`.
+            let base = out.len();
+            let fix = |mut n: Node| {
+                if !n.is_leaf() {
+                    n.first = (base + n.first as usize - 1) as u32;
+                }
+                n
+            };
+            out[at] = fix(v[0]);
+            out.extend(v[1..].iter().map(|&n| fix(n)));
+        }
+    }
 }
 
 impl Bvh {
@@ -495,10 +554,8 @@ impl Bvh {
         let nodes = if n == 0 {
             vec![Node::default()]
         } else {
-            let mut slots = vec![Node::default(); 2 * n - 1];
-            let (root, region) = slots.split_at_mut(1);
-            build_node(&mut refs, 0, bounds, cb, &mut root[0], region, 1, nb, None);
-            compact(&slots)
+            let sk = build_skeleton(&mut refs, 0, bounds, cb, nb, None);
+            assemble(sk, n)
         };
         let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();
         Bvh::finish(g, nodes, order, Builder::Binned, start)

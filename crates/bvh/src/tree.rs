@@ -13,6 +13,9 @@ pub const LEAF_MAX: usize = 4;
 pub const INNER: u32 = 0x8000_0000;
 
 /// One BVH node, 32 bytes. Children of an inner node are adjacent: `first` and `first + 1`.
+///
+/// (Tried: padding so every sibling pair fills one aligned 64-byte line. No measurable change,
+/// 8.8-9.1 vs 8.8-8.9 Mrays/s single-thread AVX-512 at 1024² on 1M primitives; not kept.)
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(32))]
 pub struct Node {

@@ -549,3 +549,87 @@ pub fn march_rays(isa: Isa, scene: &VolumeScene, rays: &Rays, out: &mut [[f32; 4
     );
     isa.dispatch(MarchBatch { scene, rays, out });
 }
+
+struct SampleBatch<'a, 'b> {
+    volume: &'a Volume,
+    p: [&'a [f32]; 3],
+    out: &'b mut [f32],
+}
+
+impl Kernel for SampleBatch<'_, '_> {
+    type Output = ();
+    // Paper §4.4: trilinear interpolation of the grid (the marcher's sampler) at given points.
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) {
+        let g = &self.volume.grid;
+        let hi = core::array::from_fn(|a| (g.dims[a] - 1) as f32);
+        let base_hi = core::array::from_fn(|a| (g.dims[a] - 2) as f32);
+        let (nx, nxy) = (g.dims[0] as i32, (g.dims[0] * g.dims[1]) as i32);
+        let inv_h = s.splat(1.0 / g.spacing);
+        let n = self.out.len();
+        let mut i = 0;
+        while i < n {
+            let ld = |a: usize| (s.load_partial(&self.p[a][i..], 0.0) - s.splat(g.origin[a])) * inv_h;
+            let p = V3::<S>::new(ld(0), ld(1), ld(2));
+            let m = s.first_n(n - i);
+            let v = match &self.volume.data {
+                VolumeData::F32(d) => {
+                    let l = Lattice { vox: F32Voxels(d), hi, base_hi, nx, nxy, scale: 1.0 };
+                    trilinear(s, &l, p, m)
+                }
+                VolumeData::U8 { data, scale } => {
+                    let l = Lattice { vox: U8Voxels(data), hi, base_hi, nx, nxy, scale: *scale };
+                    trilinear(s, &l, p, m)
+                }
+            };
+            s.store_masked(v, &mut self.out[i..], m);
+            i += S::LANES;
+        }
+    }
+}
+
+/// Trilinear interpolation of `volume` at world points (`x, y, z` slices, Å; clamped to the
+/// box) into `out`, with backend `isa` — the marcher's sampler, for probes and benchmarks.
+/// Panics if the slices' lengths differ.
+pub fn sample_points(isa: Isa, volume: &Volume, x: &[f32], y: &[f32], z: &[f32], out: &mut [f32]) {
+    assert!(x.len() == out.len() && y.len() == out.len() && z.len() == out.len());
+    isa.dispatch(SampleBatch { volume, p: [x, y, z], out });
+}
+
+struct ClassifyBatch<'a, 'b> {
+    tf: &'a ClassifiedTf,
+    values: &'a [f32],
+    out: &'b mut [[f32; 4]],
+}
+
+impl Kernel for ClassifyBatch<'_, '_> {
+    type Output = ();
+    // Paper §4.4: post-classification through the 256-entry table (the marcher's lookup).
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) {
+        let n = self.values.len();
+        let zero = s.splat(0.0);
+        let mut buf = [0.0f32; spmd::MAX_LANES];
+        let mut i = 0;
+        while i < n {
+            let m = s.first_n(n - i);
+            let idx = s.shl(bin(s, self.tf, s.load_partial(&self.values[i..], 0.0)), 2);
+            let cnt = (n - i).min(S::LANES);
+            for ch in 0..4 {
+                let v = s.gather(&self.tf.post, idx + s.splat_i(ch as i32), m, zero);
+                s.store(v, &mut buf);
+                for l in 0..cnt {
+                    self.out[i + l][ch] = buf[l];
+                }
+            }
+            i += S::LANES;
+        }
+    }
+}
+
+/// Post-classifies `values` (density units) through `tf`'s step-corrected table into
+/// premultiplied RGBA, with backend `isa` — the marcher's lookup, for benchmarks and tools.
+pub fn classify_values(isa: Isa, tf: &ClassifiedTf, values: &[f32], out: &mut [[f32; 4]]) {
+    assert_eq!(values.len(), out.len());
+    isa.dispatch(ClassifyBatch { tf, values, out });
+}

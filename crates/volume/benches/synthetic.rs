@@ -11,11 +11,17 @@ pub struct Atoms {
 }
 
 pub fn nanosphere(n: usize, r0: f64) -> Atoms {
-    let mut a = Atoms { x: vec![], y: vec![], z: vec![], r: vec![] };
+    let mut a = Atoms {
+        x: vec![],
+        y: vec![],
+        z: vec![],
+        r: vec![],
+    };
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     let mut radius = r0;
     while a.x.len() < n {
-        let m = ((4.0 * std::f64::consts::PI * radius * radius * 0.38).round() as usize).min(n - a.x.len());
+        let m = ((4.0 * std::f64::consts::PI * radius * radius * 0.38).round() as usize)
+            .min(n - a.x.len());
         let full = (4.0 * std::f64::consts::PI * radius * radius * 0.38).round() as usize;
         for i in 0..m {
             let zz = 1.0 - 2.0 * (i as f64 + 0.5) / full as f64;
@@ -36,10 +42,18 @@ pub fn camera_rays(w: usize, h: usize, eye: [f32; 3]) -> [Vec<f32>; 6] {
     let len = (eye[0] * eye[0] + eye[1] * eye[1] + eye[2] * eye[2]).sqrt();
     let f = [-eye[0] / len, -eye[1] / len, -eye[2] / len];
     let up = [0.0f32, 1.0, 0.0];
-    let mut rt = [f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]];
+    let mut rt = [
+        f[1] * up[2] - f[2] * up[1],
+        f[2] * up[0] - f[0] * up[2],
+        f[0] * up[1] - f[1] * up[0],
+    ];
     let rl = (rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]).sqrt();
     rt = rt.map(|c| c / rl);
-    let u = [rt[1] * f[2] - rt[2] * f[1], rt[2] * f[0] - rt[0] * f[2], rt[0] * f[1] - rt[1] * f[0]];
+    let u = [
+        rt[1] * f[2] - rt[2] * f[1],
+        rt[2] * f[0] - rt[0] * f[2],
+        rt[0] * f[1] - rt[1] * f[0],
+    ];
     let th = (20.0f32).to_radians().tan();
     let mut out: [Vec<f32>; 6] = Default::default();
     for j in 0..h {

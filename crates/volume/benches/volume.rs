@@ -11,10 +11,19 @@ use volume::*;
 
 fn scene() -> (synthetic::Atoms, Volume, Macrocells, ClassifiedTf) {
     let a = synthetic::nanosphere(30_000, 20.0);
-    let p = DensityParams { voxels_per_angstrom: 4.0, format: VolumeFormat::U8, budget_bytes: None };
+    let p = DensityParams {
+        voxels_per_angstrom: 4.0,
+        format: VolumeFormat::U8,
+        budget_bytes: None,
+    };
     let v = build_density(Isa::detect(), &a.x, &a.y, &a.z, &a.r, &p).unwrap();
     let mc = Macrocells::build(&v);
-    let tf = ClassifiedTf::new(&TransferFunction::preset(Preset::CoolWarm), 0.0, v.max_value, 0.5);
+    let tf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm),
+        0.0,
+        v.max_value,
+        0.5,
+    );
     (a, v, mc, tf)
 }
 
@@ -25,7 +34,9 @@ fn benches(c: &mut Criterion) {
     let n = 1 << 16;
     let mut seed = 1u64;
     let mut rnd = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((seed >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
     };
     let (mut x, mut y, mut z) = (vec![], vec![], vec![]);
@@ -59,7 +70,11 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("density_build");
     g.sample_size(10);
     g.throughput(Throughput::Elements(atoms.x.len() as u64));
-    let p = DensityParams { voxels_per_angstrom: 4.0, format: VolumeFormat::F32, budget_bytes: None };
+    let p = DensityParams {
+        voxels_per_angstrom: 4.0,
+        format: VolumeFormat::F32,
+        budget_bytes: None,
+    };
     for isa in Isa::supported() {
         g.bench_function(BenchmarkId::from_parameter(isa), |b| {
             b.iter(|| build_density(isa, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap())
@@ -77,10 +92,16 @@ fn benches(c: &mut Criterion) {
     g.sample_size(10);
     g.throughput(Throughput::Elements((size * size) as u64));
     for isa in Isa::supported() {
-        for (name, macrocells, preintegrated) in
-            [("cells+preint", true, true), ("nocells+preint", false, true), ("cells+post", true, false)]
-        {
-            let opts = MarchOptions { macrocells, preintegrated, ..Default::default() };
+        for (name, macrocells, preintegrated) in [
+            ("cells+preint", true, true),
+            ("nocells+preint", false, true),
+            ("cells+post", true, false),
+        ] {
+            let opts = MarchOptions {
+                macrocells,
+                preintegrated,
+                ..Default::default()
+            };
             let sc = VolumeScene::new(&v, &mc, &tf, opts);
             let mut out = vec![[0.0f32; 4]; size * size];
             g.bench_function(BenchmarkId::new(name, isa), |b| {
@@ -88,8 +109,16 @@ fn benches(c: &mut Criterion) {
                     for (c, o) in out.chunks_mut(256).enumerate() {
                         let r = c * 256..c * 256 + o.len();
                         let rs = Rays {
-                            origin: [&rays[0][r.clone()], &rays[1][r.clone()], &rays[2][r.clone()]],
-                            dir: [&rays[3][r.clone()], &rays[4][r.clone()], &rays[5][r.clone()]],
+                            origin: [
+                                &rays[0][r.clone()],
+                                &rays[1][r.clone()],
+                                &rays[2][r.clone()],
+                            ],
+                            dir: [
+                                &rays[3][r.clone()],
+                                &rays[4][r.clone()],
+                                &rays[5][r.clone()],
+                            ],
                             tmax: &tmax[r],
                         };
                         march_rays(isa, &sc, &rs, o);

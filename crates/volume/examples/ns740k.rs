@@ -18,35 +18,68 @@ fn main() {
     let size: usize = args.get(3).map_or(512, |s| s.parse().unwrap());
     let a = synthetic::nanosphere(n, 20.0);
     let extent = a.x.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-    println!("{} atoms, outer radius {extent:.1} Å, {} threads", a.x.len(), rayon::current_num_threads());
-    let p = DensityParams { voxels_per_angstrom: vpa, format: VolumeFormat::U8, budget_bytes: None };
+    println!(
+        "{} atoms, outer radius {extent:.1} Å, {} threads",
+        a.x.len(),
+        rayon::current_num_threads()
+    );
+    let p = DensityParams {
+        voxels_per_angstrom: vpa,
+        format: VolumeFormat::U8,
+        budget_bytes: None,
+    };
+    // BNS_ISA=name limits the run to one backend.
+    let isas = match std::env::var("BNS_ISA") {
+        Ok(_) => vec![Isa::select(None).unwrap()],
+        Err(_) => Isa::supported(),
+    };
     let mut vol = None;
-    for isa in Isa::supported() {
+    for &isa in &isas {
         let t = Instant::now();
         let v = build_density(isa, &a.x, &a.y, &a.z, &a.r, &p).unwrap();
         let dt = t.elapsed().as_secs_f64();
         println!(
             "density_build {isa:>7}: {dt:.2} s  grid {:?} = {:.0} MB u8 (scale {:.3e}, max {:.3})",
-            v.grid.dims, v.bytes() as f64 / 1e6, v.scale().unwrap(), v.max_value
+            v.grid.dims,
+            v.bytes() as f64 / 1e6,
+            v.scale().unwrap(),
+            v.max_value
         );
         vol = Some(v);
     }
     let v = vol.unwrap();
     let t = Instant::now();
     let mc = Macrocells::build(&v);
-    println!("macrocells: {:?} = {:.1} MB in {:.2} s", mc.dims, mc.bytes() as f64 / 1e6, t.elapsed().as_secs_f64());
+    println!(
+        "macrocells: {:?} = {:.1} MB in {:.2} s",
+        mc.dims,
+        mc.bytes() as f64 / 1e6,
+        t.elapsed().as_secs_f64()
+    );
     let t = Instant::now();
-    let ctf = ClassifiedTf::new(&TransferFunction::preset(Preset::CoolWarm), 0.0, v.max_value, 0.5);
-    println!("classified TF (pre-integration table): {:.3} s", t.elapsed().as_secs_f64());
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    println!(
+        "classified TF (pre-integration table): {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
 
     // Far: whole sphere in view; close: a quarter of the distance.
     let far = extent / (20.0f32).to_radians().tan() * 1.1;
     for (view, dist) in [("far", far), ("close", far * 0.25)] {
         let rays = synthetic::camera_rays(size, size, [0.0, 0.3 * dist, dist]);
         let tmax = vec![f32::INFINITY; size * size];
-        for isa in Isa::supported() {
+        for &isa in &isas {
             for (macrocells, preintegrated) in [(true, true), (false, true), (true, false)] {
-                let opts = MarchOptions { macrocells, preintegrated, ..Default::default() };
+                let opts = MarchOptions {
+                    macrocells,
+                    preintegrated,
+                    ..Default::default()
+                };
                 let sc = VolumeScene::new(&v, &mc, &ctf, opts);
                 let mut out = vec![[0.0f32; 4]; size * size];
                 let t = Instant::now();
@@ -54,8 +87,16 @@ fn main() {
                 out.par_chunks_mut(256).enumerate().for_each(|(c, o)| {
                     let r = c * 256..(c * 256 + o.len());
                     let rs = Rays {
-                        origin: [&rays[0][r.clone()], &rays[1][r.clone()], &rays[2][r.clone()]],
-                        dir: [&rays[3][r.clone()], &rays[4][r.clone()], &rays[5][r.clone()]],
+                        origin: [
+                            &rays[0][r.clone()],
+                            &rays[1][r.clone()],
+                            &rays[2][r.clone()],
+                        ],
+                        dir: [
+                            &rays[3][r.clone()],
+                            &rays[4][r.clone()],
+                            &rays[5][r.clone()],
+                        ],
                         tmax: &tmax[r],
                     };
                     march_rays(isa, &sc, &rs, o);

@@ -33,7 +33,9 @@ pub use grid::{
     VolumeFormat,
 };
 pub use macrocell::{Macrocells, MACROCELL};
-pub use march::{classify_values, march, march_rays, sample_points, Lighting, MarchOptions, Rays, VolumeScene};
+pub use march::{
+    classify_values, march, march_rays, sample_points, Lighting, MarchOptions, Rays, VolumeScene,
+};
 pub use tf::{
     preintegrate, ClassifiedTf, ControlPoint, Preset, TfError, TransferFunction, TF_SIZE,
 };

@@ -441,7 +441,7 @@ fn march_impl<S: Simd, V: Voxels>(
             if s.any(shading) {
                 let shade = shade(s, lat, og.mul_add(dg, tb), light, shading);
                 for ch in c.iter_mut().take(3) {
-                    *ch = *ch * shade;
+                    *ch *= shade;
                 }
             }
         }
@@ -525,8 +525,8 @@ impl Kernel for MarchBatch<'_, '_> {
             let cnt = (n - i).min(S::LANES);
             for (ch, v) in c.into_iter().enumerate() {
                 s.store(v, &mut buf);
-                for l in 0..cnt {
-                    self.out[i + l][ch] = buf[l];
+                for (o, b) in self.out[i..i + cnt].iter_mut().zip(buf) {
+                    o[ch] = b;
                 }
             }
             i += S::LANES;
@@ -569,16 +569,31 @@ impl Kernel for SampleBatch<'_, '_> {
         let n = self.out.len();
         let mut i = 0;
         while i < n {
-            let ld = |a: usize| (s.load_partial(&self.p[a][i..], 0.0) - s.splat(g.origin[a])) * inv_h;
+            let ld =
+                |a: usize| (s.load_partial(&self.p[a][i..], 0.0) - s.splat(g.origin[a])) * inv_h;
             let p = V3::<S>::new(ld(0), ld(1), ld(2));
             let m = s.first_n(n - i);
             let v = match &self.volume.data {
                 VolumeData::F32(d) => {
-                    let l = Lattice { vox: F32Voxels(d), hi, base_hi, nx, nxy, scale: 1.0 };
+                    let l = Lattice {
+                        vox: F32Voxels(d),
+                        hi,
+                        base_hi,
+                        nx,
+                        nxy,
+                        scale: 1.0,
+                    };
                     trilinear(s, &l, p, m)
                 }
                 VolumeData::U8 { data, scale } => {
-                    let l = Lattice { vox: U8Voxels(data), hi, base_hi, nx, nxy, scale: *scale };
+                    let l = Lattice {
+                        vox: U8Voxels(data),
+                        hi,
+                        base_hi,
+                        nx,
+                        nxy,
+                        scale: *scale,
+                    };
                     trilinear(s, &l, p, m)
                 }
             };
@@ -593,7 +608,11 @@ impl Kernel for SampleBatch<'_, '_> {
 /// Panics if the slices' lengths differ.
 pub fn sample_points(isa: Isa, volume: &Volume, x: &[f32], y: &[f32], z: &[f32], out: &mut [f32]) {
     assert!(x.len() == out.len() && y.len() == out.len() && z.len() == out.len());
-    isa.dispatch(SampleBatch { volume, p: [x, y, z], out });
+    isa.dispatch(SampleBatch {
+        volume,
+        p: [x, y, z],
+        out,
+    });
 }
 
 struct ClassifyBatch<'a, 'b> {
@@ -618,8 +637,8 @@ impl Kernel for ClassifyBatch<'_, '_> {
             for ch in 0..4 {
                 let v = s.gather(&self.tf.post, idx + s.splat_i(ch as i32), m, zero);
                 s.store(v, &mut buf);
-                for l in 0..cnt {
-                    self.out[i + l][ch] = buf[l];
+                for (o, b) in self.out[i..i + cnt].iter_mut().zip(buf) {
+                    o[ch] = b;
                 }
             }
             i += S::LANES;

@@ -449,3 +449,57 @@ fn preintegration_of_a_constant_segment_is_the_post_classification() {
     assert!((a - c.preint[(b * 256 + f) * 4 + 3]).abs() < 1e-6);
     assert_ne!(c.preint[(f * 256 + b) * 4], c.preint[(b * 256 + f) * 4]);
 }
+
+#[test]
+fn batch_sampler_and_classifier_match_scalar_references() {
+    let (v, _) = shell_scene(VolumeFormat::U8);
+    let mut rng = Rng(5);
+    let n = 1001;
+    let pts: Vec<[f64; 3]> = (0..n)
+        .map(|_| {
+            [
+                rng.range(-17.0, 17.0),
+                rng.range(-17.0, 17.0),
+                rng.range(-17.0, 17.0),
+            ]
+        })
+        .collect();
+    let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = (
+        pts.iter().map(|p| p[0] as f32).collect(),
+        pts.iter().map(|p| p[1] as f32).collect(),
+        pts.iter().map(|p| p[2] as f32).collect(),
+    );
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::Viridis),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    for isa in Isa::supported() {
+        let mut out = vec![0.0; n];
+        sample_points(isa, &v, &x, &y, &z, &mut out);
+        for i in 0..n {
+            let p = [x[i] as f64, y[i] as f64, z[i] as f64];
+            let want = v.sample_trilinear(p);
+            assert!(
+                (out[i] as f64 - want).abs() <= 1e-5 * (1.0 + want),
+                "{isa} {p:?}: {} vs {want}",
+                out[i]
+            );
+        }
+        let mut rgba = vec![[0.0; 4]; n];
+        classify_values(isa, &ctf, &out, &mut rgba);
+        for i in 0..n {
+            let b = ctf.bin(out[i]);
+            assert_eq!(
+                rgba[i],
+                [
+                    ctf.post[4 * b],
+                    ctf.post[4 * b + 1],
+                    ctf.post[4 * b + 2],
+                    ctf.post[4 * b + 3]
+                ]
+            );
+        }
+    }
+}

@@ -22,6 +22,35 @@
 //!
 //! Transfer functions: [`Preset`]s (`coolwarm`, `viridis`, `grayscale`) or a text file of
 //! control points `value r g b a` — see the [`tf`] module for the format.
+//!
+//! ## Use from a renderer
+//! ```
+//! use spmd::Isa;
+//! use volume::*;
+//! # fn main() -> Result<(), VolumeError> {
+//! let isa = Isa::detect();
+//! // Once per data set (atoms as SoA slices, Å; r = covalent radius).
+//! let (x, y, z, r) = (vec![0.0f32, 1.4], vec![0.0f32, 0.0], vec![0.0f32, 0.0], vec![0.76f32; 2]);
+//! let params = DensityParams { voxels_per_angstrom: 4.0, format: VolumeFormat::U8, budget_bytes: None };
+//! let vol = build_density(isa, &x, &y, &z, &r, &params)?;
+//! let cells = Macrocells::build(&vol);
+//! // Whenever the transfer function (or its value range) changes.
+//! let tf = ClassifiedTf::new(&TransferFunction::preset(Preset::CoolWarm), 0.0, vol.max_value, 0.5);
+//! // Per frame.
+//! let scene = VolumeScene::new(&vol, &cells, &tf, MarchOptions::default());
+//! // Per tile (e.g. inside a rayon task): SoA rays, `tmax` = opaque depth of the b&s pass
+//! // in units of |dir| (f32::INFINITY for the volume alone).
+//! let (ox, oy, oz) = ([-5.0f32], [0.0f32], [0.0f32]);
+//! let (dx, dy, dz) = ([1.0f32], [0.0f32], [0.0f32]);
+//! let tmax = [f32::INFINITY];
+//! let mut rgba = [[0.0f32; 4]];
+//! march_rays(isa, &scene, &Rays { origin: [&ox, &oy, &oz], dir: [&dx, &dy, &dz], tmax: &tmax }, &mut rgba);
+//! assert!(rgba[0][3] > 0.0);
+//! // Premultiplied: pixel = rgb + (1 - a) * background (the b&s colour in vol+bs mode).
+//! # Ok(()) }
+//! ```
+//! Inside a renderer's own SIMD kernel, call [`march()`] on a packet instead
+//! (`march::<S>(s, &scene, orig, dir, tmax, active)` → `[r, g, b, a]` varying).
 
 pub mod grid;
 pub mod macrocell;

@@ -503,3 +503,64 @@ fn batch_sampler_and_classifier_match_scalar_references() {
         }
     }
 }
+
+#[test]
+fn lighting_scales_colour_only() {
+    // One atom; lighting must leave opacity unchanged, never brighten, and on the axis
+    // through the centre the headlight sees the gradient head-on (almost no darkening).
+    let atoms = Atoms {
+        x: vec![0.0],
+        y: vec![0.0],
+        z: vec![0.0],
+        r: vec![1.5],
+    };
+    let p = DensityParams {
+        voxels_per_angstrom: 8.0,
+        format: VolumeFormat::F32,
+        budget_bytes: None,
+    };
+    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
+    let mc = Macrocells::build(&v);
+    let ctf = ClassifiedTf::new(&ramp_tf(), 0.0, v.max_value, 0.5);
+    let mut b = atom_rays(f32::INFINITY);
+    b.push([-8.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
+    let unlit = b.render(
+        Isa::detect(),
+        &VolumeScene::new(&v, &mc, &ctf, MarchOptions::default()),
+    );
+    let mut darker = 0;
+    for lighting in [Lighting::Headlight, Lighting::Directional([0.0, 1.0, 0.0])] {
+        let opts = MarchOptions {
+            lighting,
+            ..Default::default()
+        };
+        let lit = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
+        for (l, u) in lit.iter().zip(&unlit) {
+            assert!(
+                (l[3] - u[3]).abs() < 1e-6,
+                "{lighting:?}: opacity changed {l:?} vs {u:?}"
+            );
+            for c in 0..3 {
+                assert!(
+                    l[c] <= u[c] + 1e-6 && l[c] >= 0.3 * u[c] - 1e-6,
+                    "{lighting:?}: {l:?} vs {u:?}"
+                );
+            }
+            darker += (l[0] < 0.95 * u[0]) as usize;
+        }
+    }
+    assert!(
+        darker > 10,
+        "lighting must visibly shade some rays ({darker})"
+    );
+    let opts = MarchOptions {
+        lighting: Lighting::Headlight,
+        ..Default::default()
+    };
+    let lit = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
+    let (l, u) = (lit.last().unwrap(), unlit.last().unwrap());
+    assert!(
+        u[3] > 0.3 && l[0] > 0.9 * u[0],
+        "axis ray: lit {l:?} unlit {u:?}"
+    );
+}

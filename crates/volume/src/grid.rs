@@ -127,7 +127,9 @@ impl Grid {
 
     /// Total number of lattice points.
     pub fn voxel_count(&self) -> u64 {
-        self.dims.iter().map(|&d| d as u64).product()
+        self.dims
+            .iter()
+            .fold(1u64, |n, &d| n.saturating_mul(d as u64))
     }
 
     /// Upper corner of the box (Å).
@@ -269,22 +271,25 @@ const SLAB: usize = 4;
 /// Bytes the build will hold at its peak for `grid` in `format`: the voxels (+4 bytes of
 /// padding), the macrocell grid, and for u8 one f32 slab per worker thread.
 pub fn estimate_bytes(grid: &Grid, format: VolumeFormat) -> u64 {
-    let voxels = grid.voxel_count() * format.bytes_per_voxel() + 4;
-    let cells: u64 = grid
-        .dims
-        .iter()
-        .map(|&d| {
+    let voxels = grid
+        .voxel_count()
+        .saturating_mul(format.bytes_per_voxel())
+        .saturating_add(4);
+    let cells: u64 = grid.dims.iter().fold(1u64, |n, &d| {
+        n.saturating_mul(
             (d as u64 - 1)
                 .div_ceil(crate::macrocell::MACROCELL as u64)
-                .max(1)
-        })
-        .product();
+                .max(1),
+        )
+    });
     let slab = (SLAB * grid.dims[0] * grid.dims[1]) as u64 * 4;
     let scratch = match format {
         VolumeFormat::U8 => slab * rayon::current_num_threads() as u64,
         VolumeFormat::F32 => 0,
     };
-    voxels + cells * 8 + scratch
+    voxels
+        .saturating_add(cells.saturating_mul(8))
+        .saturating_add(scratch)
 }
 
 /// 75 % of `MemAvailable` in `/proc/meminfo`, or `None` where that cannot be read.

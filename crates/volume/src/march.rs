@@ -75,13 +75,19 @@ pub struct VolumeScene<'a> {
 }
 
 impl<'a> VolumeScene<'a> {
-    /// Bundles the parts.
+    /// Bundles the parts. Panics if `cells` was not built for a grid of `volume`'s shape.
     pub fn new(
         volume: &'a Volume,
         cells: &'a Macrocells,
         tf: &'a ClassifiedTf,
         opts: MarchOptions,
     ) -> Self {
+        let g = &volume.grid;
+        assert!(
+            (0..3).all(|a| cells.dims[a] == (g.dims[a] - 1).div_ceil(MACROCELL).max(1))
+                && cells.minmax.len() == 2 * cells.dims.iter().product::<usize>(),
+            "VolumeScene: macrocells do not match the volume's grid"
+        );
         VolumeScene {
             volume,
             cells,
@@ -304,8 +310,10 @@ fn march_impl<S: Simd, V: Voxels>(
         t_in = s.max(s.min(t0, t1), t_in);
         t_end = s.min(s.max(t0, t1), t_end);
     }
-    let mut alive = active & s.lt(t_in, t_end);
     let dt = s.splat(tf.step_voxels) / s.sqrt(dg.dot(dg));
+    // A NaN in the ray leaves t_end = +inf (min/max skip NaN), a zero direction makes dt
+    // infinite: such lanes see nothing (and must not march forever).
+    let mut alive = active & s.lt(t_in, t_end) & s.lt(t_end, inf) & s.lt(dt, inf) & s.gt(dt, zero);
     let t0 = t_in;
 
     // Accumulators and marching state.

@@ -564,3 +564,39 @@ fn lighting_scales_colour_only() {
         "axis ray: lit {l:?} unlit {u:?}"
     );
 }
+
+#[test]
+fn degenerate_rays_terminate_with_nothing() {
+    let (v, mc) = shell_scene(VolumeFormat::U8);
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let mut b = Batch::new();
+    b.push([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], f32::INFINITY); // zero direction
+    b.push([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
+    b.push([0.0, 0.0, 0.0], [1.0, f64::NAN, 0.0], f32::INFINITY);
+    b.push([-30.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::NAN);
+    b.push([-30.0, 0.0, 0.0], [1.0, 0.0, 0.0], -5.0);
+    b.push([-30.0, 0.0, 0.0], [-1.0, 0.0, 0.0], f32::INFINITY); // pointing away
+    b.push([-30.0, 0.0, 0.0], [1e-30, 0.0, 0.0], f32::INFINITY); // tiny direction
+    for opts in all_opts().into_iter().flat_map(|o| {
+        [
+            o,
+            MarchOptions {
+                macrocells: false,
+                ..o
+            },
+        ]
+    }) {
+        for isa in Isa::supported() {
+            let out = b.render(isa, &VolumeScene::new(&v, &mc, &ctf, opts));
+            for (i, c) in out.iter().enumerate().take(6) {
+                assert_eq!(*c, [0.0; 4], "{isa} {opts:?} ray {i}");
+            }
+            assert!(out[6].iter().all(|x| x.is_finite()));
+        }
+    }
+}

@@ -1,0 +1,376 @@
+//! Transfer functions: a 256-entry RGBA table over a value range, presets, a text format, and
+//! the per-render tables derived from it (step-corrected post-classification table,
+//! pre-integration table, range-max opacity table for macrocell emptiness).
+//!
+//! ## Meaning of an entry
+//! Entry `i` (0..=255) classifies the normalised value `i / 255` of the range `[lo, hi]`
+//! (density units; by default `[0, Volume::max_value]`). Between entries the classification is
+//! the linear interpolation of the entries. `r, g, b` are the emitted colour in `[0, 1]`; `a`
+//! is the **opacity of one voxel of path length** (extinction `τ = −ln(1 − a)` per voxel), so a
+//! step of `Δ` voxels has opacity `1 − (1 − a)^Δ` (opacity correction).
+//!
+//! ## Text format
+//! One control point per line: `value r g b a`, five numbers separated by blanks (or commas),
+//! `value` in `[0, 1]` of the normalised range, colour and opacity in `[0, 1]`. Values must not
+//! decrease (two equal values make a step). `#` starts a comment; blank lines are ignored. At
+//! least two points. Entries before the first / after the last point take that point's
+//! colour. Example:
+//! ```text
+//! # value  r    g    b    a
+//!   0.0    0.0  0.0  0.5  0.0
+//!   0.2    0.0  0.0  0.5  0.0   # transparent below 0.2
+//!   1.0    1.0  0.8  0.2  0.3
+//! ```
+
+use std::path::Path;
+
+use rayon::prelude::*;
+
+/// Number of transfer-function entries (bins).
+pub const TF_SIZE: usize = 256;
+
+/// A 256-entry RGBA table (colour in `[0,1]`, alpha = opacity per voxel of path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransferFunction {
+    /// The entries; entry `i` classifies normalised value `i / 255`.
+    pub table: Vec<[f32; 4]>,
+}
+
+/// A control point of the text format: normalised value and RGBA.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlPoint {
+    /// Position in `[0, 1]` of the normalised value range.
+    pub value: f32,
+    /// Colour and opacity per voxel, each in `[0, 1]`.
+    pub rgba: [f32; 4],
+}
+
+/// Built-in transfer functions suited to the density: transparent below ~15 % of the range
+/// (empty space and the tails of the Gaussians), then a smooth opacity ramp.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// Moreland's diverging cool-warm (blue → grey → red).
+    CoolWarm,
+    /// A viridis-like ramp (purple → teal → yellow).
+    Viridis,
+    /// White, for tests and for checking shapes.
+    Grayscale,
+}
+
+impl Preset {
+    /// Every preset.
+    pub const ALL: [Preset; 3] = [Preset::CoolWarm, Preset::Viridis, Preset::Grayscale];
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::CoolWarm => "coolwarm",
+            Preset::Viridis => "viridis",
+            Preset::Grayscale => "grayscale",
+        }
+    }
+}
+
+impl core::str::FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Preset, String> {
+        let l = s.trim().to_ascii_lowercase();
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.name() == l || (l == "cool-warm" && *p == Preset::CoolWarm))
+            .ok_or_else(|| format!("unknown transfer function preset {s:?}: expected coolwarm, viridis or grayscale"))
+    }
+}
+
+/// Why a transfer-function file could not be used: where and what.
+#[derive(Debug, thiserror::Error)]
+pub enum TfError {
+    /// A problem on one line (1-based) of `source`.
+    #[error("{source_name}:{line}: {message}")]
+    Line {
+        /// File name (or a label for in-memory text).
+        source_name: String,
+        /// 1-based line number.
+        line: usize,
+        /// What was wrong and what was expected.
+        message: String,
+    },
+    /// A problem with the whole file.
+    #[error("{source_name}: {message}")]
+    File {
+        /// File name (or label).
+        source_name: String,
+        /// What was wrong.
+        message: String,
+    },
+    /// The file could not be read.
+    #[error("{source_name}: {err}")]
+    Io {
+        /// File name.
+        source_name: String,
+        /// The I/O error.
+        err: std::io::Error,
+    },
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+impl TransferFunction {
+    /// From control points (sorted by non-decreasing value; at least one).
+    pub fn from_control_points(points: &[ControlPoint]) -> TransferFunction {
+        assert!(
+            !points.is_empty(),
+            "transfer function needs a control point"
+        );
+        let table = (0..TF_SIZE)
+            .map(|i| {
+                let x = i as f32 / 255.0;
+                let j = points.partition_point(|p| p.value <= x);
+                if j == 0 {
+                    points[0].rgba
+                } else if j == points.len() {
+                    points[j - 1].rgba
+                } else {
+                    let (a, b) = (points[j - 1], points[j]);
+                    let t = (x - a.value) / (b.value - a.value);
+                    core::array::from_fn(|c| a.rgba[c] + (b.rgba[c] - a.rgba[c]) * t)
+                }
+            })
+            .collect();
+        TransferFunction { table }
+    }
+
+    /// A preset with its default opacity ramp: `a = 0.2 · smoothstep(0.15, 0.85, x)`.
+    pub fn preset(p: Preset) -> TransferFunction {
+        let colours: &[(f32, [f32; 3])] = match p {
+            Preset::CoolWarm => &[
+                (0.0, [0.230, 0.299, 0.754]),
+                (0.25, [0.552, 0.690, 0.996]),
+                (0.5, [0.865, 0.865, 0.865]),
+                (0.75, [0.958, 0.604, 0.482]),
+                (1.0, [0.706, 0.016, 0.150]),
+            ],
+            Preset::Viridis => &[
+                (0.0, [0.267, 0.005, 0.329]),
+                (0.125, [0.283, 0.141, 0.458]),
+                (0.25, [0.254, 0.265, 0.530]),
+                (0.375, [0.207, 0.372, 0.553]),
+                (0.5, [0.164, 0.471, 0.558]),
+                (0.625, [0.128, 0.567, 0.551]),
+                (0.75, [0.135, 0.659, 0.518]),
+                (0.875, [0.478, 0.821, 0.319]),
+                (1.0, [0.993, 0.906, 0.144]),
+            ],
+            Preset::Grayscale => &[(0.0, [1.0, 1.0, 1.0]), (1.0, [1.0, 1.0, 1.0])],
+        };
+        let pts: Vec<ControlPoint> = colours
+            .iter()
+            .map(|&(value, c)| ControlPoint {
+                value,
+                rgba: [c[0], c[1], c[2], 0.0],
+            })
+            .collect();
+        let mut tf = TransferFunction::from_control_points(&pts);
+        for (i, e) in tf.table.iter_mut().enumerate() {
+            e[3] = 0.2 * smoothstep(0.15, 0.85, i as f32 / 255.0);
+        }
+        tf
+    }
+
+    /// Multiplies every opacity by `k` (clamped to `[0, 1]`).
+    pub fn scale_opacity(mut self, k: f32) -> Self {
+        for e in &mut self.table {
+            e[3] = (e[3] * k).clamp(0.0, 1.0);
+        }
+        self
+    }
+
+    /// Parses the text format (see the module docs); `source_name` labels errors.
+    pub fn parse(text: &str, source_name: &str) -> Result<TransferFunction, TfError> {
+        let err = |line: usize, message: String| TfError::Line {
+            source_name: source_name.to_string(),
+            line,
+            message,
+        };
+        let mut points: Vec<ControlPoint> = Vec::new();
+        for (n, raw) in text.lines().enumerate() {
+            let line = n + 1;
+            let body = raw.split('#').next().unwrap_or("");
+            let fields: Vec<&str> = body
+                .split(|c: char| c.is_whitespace() || c == ',')
+                .filter(|f| !f.is_empty())
+                .collect();
+            if fields.is_empty() {
+                continue;
+            }
+            if fields.len() != 5 {
+                return Err(err(
+                    line,
+                    format!(
+                        "expected 5 numbers `value r g b a`, found {} field(s)",
+                        fields.len()
+                    ),
+                ));
+            }
+            let mut v = [0.0f32; 5];
+            for (k, f) in fields.iter().enumerate() {
+                let name = ["value", "r", "g", "b", "a"][k];
+                let x: f32 = f
+                    .parse()
+                    .map_err(|_| err(line, format!("{name}: {f:?} is not a number")))?;
+                if !(0.0..=1.0).contains(&x) {
+                    return Err(err(line, format!("{name} = {f} is outside [0, 1]")));
+                }
+                v[k] = x;
+            }
+            if let Some(prev) = points.last() {
+                if v[0] < prev.value {
+                    return Err(err(
+                        line,
+                        format!(
+                            "value {} is less than the previous point's {}: values must not decrease",
+                            v[0], prev.value
+                        ),
+                    ));
+                }
+            }
+            points.push(ControlPoint {
+                value: v[0],
+                rgba: [v[1], v[2], v[3], v[4]],
+            });
+        }
+        if points.len() < 2 {
+            return Err(TfError::File {
+                source_name: source_name.to_string(),
+                message: format!(
+                    "need at least 2 control points `value r g b a`, found {}",
+                    points.len()
+                ),
+            });
+        }
+        Ok(TransferFunction::from_control_points(&points))
+    }
+
+    /// Reads and parses a transfer-function file.
+    pub fn load(path: &Path) -> Result<TransferFunction, TfError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|err| TfError::Io {
+            source_name: name.clone(),
+            err,
+        })?;
+        TransferFunction::parse(&text, &name)
+    }
+
+    /// The continuous classification at bin coordinate `x ∈ [0, 255]` (linear interpolation of
+    /// the entries; clamped outside).
+    pub fn eval(&self, x: f64) -> [f64; 4] {
+        let x = x.clamp(0.0, 255.0);
+        let i = (x.floor() as usize).min(TF_SIZE - 2);
+        let t = x - i as f64;
+        let (a, b) = (self.table[i], self.table[i + 1]);
+        core::array::from_fn(|c| a[c] as f64 * (1.0 - t) + b[c] as f64 * t)
+    }
+}
+
+/// Extinction per voxel of an opacity per voxel (capped so fully opaque stays finite).
+#[inline]
+pub fn extinction(alpha: f64) -> f64 {
+    -(1.0 - alpha.clamp(0.0, 1.0 - 1e-6)).ln()
+}
+
+/// Tables derived from a transfer function for one value range and one step length; cheap to
+/// rebuild when the transfer function changes (no volume or macrocell rebuild).
+#[derive(Clone, Debug)]
+pub struct ClassifiedTf {
+    /// Value mapped to entry 0.
+    pub lo: f32,
+    /// Value mapped to entry 255.
+    pub hi: f32,
+    /// `255 / (hi − lo)`: value → bin coordinate.
+    pub to_bin: f32,
+    /// Step length (voxels) the tables are corrected for.
+    pub step_voxels: f32,
+    /// Post-classification: per bin, premultiplied `[r·α, g·α, b·α, α]` with
+    /// `α = 1 − (1 − a)^step` (interleaved, 256 × 4).
+    pub post: Vec<f32>,
+    /// Pre-integrated: per (front bin, back bin) the premultiplied colour and opacity of a
+    /// segment of `step` voxels along which the value goes linearly from front to back
+    /// (interleaved, index `(front·256 + back)·4`).
+    pub preint: Vec<f32>,
+    /// Max opacity per voxel over entries `[i, j]` (either order), index `i·256 + j`;
+    /// a macrocell is empty when this is 0 over its (widened) bin range.
+    pub range_max: Vec<f32>,
+}
+
+impl ClassifiedTf {
+    /// Classifies `tf` over values `[lo, hi]` (density units) for steps of `step_voxels`.
+    pub fn new(tf: &TransferFunction, lo: f32, hi: f32, step_voxels: f32) -> ClassifiedTf {
+        assert!(hi > lo, "transfer function range must be non-empty");
+        assert!(step_voxels > 0.0);
+        let d = step_voxels as f64;
+        let mut post = vec![0.0f32; TF_SIZE * 4];
+        for (i, e) in tf.table.iter().enumerate() {
+            let a = 1.0 - (-d * extinction(e[3] as f64)).exp();
+            for c in 0..3 {
+                post[i * 4 + c] = (e[c] as f64 * a) as f32;
+            }
+            post[i * 4 + 3] = a as f32;
+        }
+        let mut preint = vec![0.0f32; TF_SIZE * TF_SIZE * 4];
+        preint
+            .par_chunks_mut(TF_SIZE * 4)
+            .enumerate()
+            .for_each(|(f, row)| {
+                for b in 0..TF_SIZE {
+                    let v = preintegrate(tf, f as f64, b as f64, d);
+                    for c in 0..4 {
+                        row[b * 4 + c] = v[c] as f32;
+                    }
+                }
+            });
+        let mut range_max = vec![0.0f32; TF_SIZE * TF_SIZE];
+        for i in 0..TF_SIZE {
+            let mut m = 0.0f32;
+            for j in i..TF_SIZE {
+                m = m.max(tf.table[j][3]);
+                range_max[i * TF_SIZE + j] = m;
+                range_max[j * TF_SIZE + i] = m;
+            }
+        }
+        ClassifiedTf {
+            lo,
+            hi,
+            to_bin: 255.0 / (hi - lo),
+            step_voxels,
+            post,
+            preint,
+            range_max,
+        }
+    }
+
+    /// Bin (0..=255) of a value, as the kernels compute it: `round(clamp((v − lo)·to_bin))`.
+    pub fn bin(&self, v: f32) -> usize {
+        (((v - self.lo) * self.to_bin).clamp(0.0, 255.0) + 0.5) as usize
+    }
+}
+
+/// Premultiplied RGBA of a segment of `len` voxels whose bin coordinate goes linearly from
+/// `f` to `b`: front-to-back composition of `2·|b − f| + 1` sub-steps classified at their
+/// midpoints, each with exact opacity `1 − exp(−τ·len/n)`.
+pub fn preintegrate(tf: &TransferFunction, f: f64, b: f64, len: f64) -> [f64; 4] {
+    let n = (2.0 * (b - f).abs()).ceil() as usize + 1;
+    let dl = len / n as f64;
+    let (mut c, mut t) = ([0.0f64; 3], 1.0f64);
+    for k in 0..n {
+        let x = f + (b - f) * (k as f64 + 0.5) / n as f64;
+        let e = tf.eval(x);
+        let a = 1.0 - (-dl * extinction(e[3])).exp();
+        for ch in 0..3 {
+            c[ch] += t * e[ch] * a;
+        }
+        t *= 1.0 - a;
+    }
+    [c[0], c[1], c[2], 1.0 - t]
+}

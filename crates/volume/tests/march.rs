@@ -1,0 +1,602 @@
+//! Ray marching against a double-precision reference integration, backends against scalar,
+//! macrocell skipping against none, and transfer-function file errors.
+
+mod common;
+
+use common::*;
+use spmd::Isa;
+use volume::*;
+
+struct Batch {
+    o: [Vec<f32>; 3],
+    d: [Vec<f32>; 3],
+    tmax: Vec<f32>,
+}
+impl Batch {
+    fn new() -> Self {
+        Batch {
+            o: Default::default(),
+            d: Default::default(),
+            tmax: vec![],
+        }
+    }
+    fn push(&mut self, o: [f64; 3], d: [f64; 3], tmax: f32) {
+        for a in 0..3 {
+            self.o[a].push(o[a] as f32);
+            self.d[a].push(d[a] as f32);
+        }
+        self.tmax.push(tmax);
+    }
+    fn rays(&self) -> Rays<'_> {
+        Rays {
+            origin: [&self.o[0], &self.o[1], &self.o[2]],
+            dir: [&self.d[0], &self.d[1], &self.d[2]],
+            tmax: &self.tmax,
+        }
+    }
+    fn render(&self, isa: Isa, sc: &VolumeScene) -> Vec<[f32; 4]> {
+        let mut out = vec![[0.0; 4]; self.tmax.len()];
+        march_rays(isa, sc, &self.rays(), &mut out);
+        out
+    }
+}
+
+fn ramp_tf() -> TransferFunction {
+    // Colour varies with value so colour errors show; transparent below 0.2 (the Gaussian's
+    // cutoff, where Φ jumps, is at e^-2 ≈ 0.135 of the peak).
+    let mut tf = TransferFunction::preset(Preset::CoolWarm);
+    for (i, e) in tf.table.iter_mut().enumerate() {
+        let x = i as f32 / 255.0;
+        let t = ((x - 0.2) / 0.7).clamp(0.0, 1.0);
+        e[3] = 0.25 * t * t * (3.0 - 2.0 * t);
+    }
+    tf
+}
+
+/// Front-to-back emission-absorption along the ray in f64, step `dv` voxels, classification
+/// = linear interpolation of the entries of `tf` over [lo, hi], opacity per voxel.
+#[allow(clippy::too_many_arguments)]
+fn reference(
+    field: &dyn Fn([f64; 3]) -> f64,
+    tf: &TransferFunction,
+    lo: f64,
+    hi: f64,
+    grid: &Grid,
+    o: [f64; 3],
+    d: [f64; 3],
+    tmax: f64,
+) -> [f64; 4] {
+    let h = grid.spacing as f64;
+    let bmax = grid.max_corner();
+    let (mut t0, mut t1) = (0.0f64, tmax);
+    for a in 0..3 {
+        let inv = 1.0 / d[a];
+        let (ta, tb) = (
+            (grid.origin[a] as f64 - o[a]) * inv,
+            (bmax[a] as f64 - o[a]) * inv,
+        );
+        t0 = t0.max(ta.min(tb));
+        t1 = t1.min(ta.max(tb));
+    }
+    let mut c = [0.0f64; 3];
+    let mut trans = 1.0f64;
+    if t0 >= t1 {
+        return [0.0; 4];
+    }
+    let dl = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let dv = 0.002; // voxels per reference step
+    let n = ((t1 - t0) * dl / h / dv).ceil() as usize;
+    let dt = (t1 - t0) / n as f64;
+    let step_vox = dt * dl / h;
+    for i in 0..n {
+        let t = t0 + (i as f64 + 0.5) * dt;
+        let p = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
+        let x = (field(p) - lo) / (hi - lo) * 255.0;
+        let e = tf.eval(x);
+        let a = 1.0 - (-step_vox * tf::extinction(e[3])).exp();
+        for ch in 0..3 {
+            c[ch] += trans * e[ch] * a;
+        }
+        trans *= 1.0 - a;
+    }
+    [c[0], c[1], c[2], 1.0 - trans]
+}
+
+fn max_err(a: &[[f32; 4]], b: &[[f64; 4]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..4).map(move |c| (x[c] as f64 - y[c]).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// Rays through a single atom at the origin: a fan of offsets, oblique directions.
+fn atom_rays(tmax: f32) -> Batch {
+    let mut b = Batch::new();
+    let mut rng = Rng(42);
+    for i in 0..64 {
+        let off = [rng.range(-2.2, 2.2), rng.range(-2.2, 2.2)];
+        let d = [1.0, rng.range(-0.3, 0.3), rng.range(-0.3, 0.3)];
+        // Start outside the volume on the -x side, passing near the atom.
+        let o = [-8.0, off[0] - d[1] * 8.0, off[1] - d[2] * 8.0];
+        let tmax = if i % 4 == 3 {
+            8.0 + rng.range(-1.0, 1.0) as f32
+        } else {
+            tmax
+        };
+        b.push(o, d, tmax);
+    }
+    b
+}
+
+#[test]
+fn single_atom_matches_double_precision_reference_integration() {
+    // Fine grid so trilinear interpolation error is small against the analytic field.
+    let r = 1.5f32;
+    let atoms = Atoms {
+        x: vec![0.0],
+        y: vec![0.0],
+        z: vec![0.0],
+        r: vec![r],
+    };
+    let p = DensityParams {
+        voxels_per_angstrom: 8.0,
+        format: VolumeFormat::F32,
+        budget_bytes: None,
+    };
+    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
+    let mc = Macrocells::build(&v);
+    let tf = ramp_tf();
+    let hi = v.max_value;
+    let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);
+    let field = |q: [f64; 3]| phi(&atoms, q);
+    let b = atom_rays(f32::INFINITY);
+    let want: Vec<[f64; 4]> = (0..b.tmax.len())
+        .map(|i| {
+            let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
+            let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
+            reference(&field, &tf, 0.0, hi as f64, &v.grid, o, d, b.tmax[i] as f64)
+        })
+        .collect();
+    assert!(
+        want.iter().filter(|w| w[3] > 0.2).count() > 10,
+        "rays must cross dense parts"
+    );
+    assert!(
+        want.iter().filter(|w| w[3] == 0.0).count() > 3,
+        "and some must miss"
+    );
+    for (preintegrated, tol) in [(true, 3.0 / 255.0), (false, 9.0 / 255.0)] {
+        for macrocells in [true, false] {
+            let opts = MarchOptions {
+                preintegrated,
+                macrocells,
+                ..Default::default()
+            };
+            let sc = VolumeScene::new(&v, &mc, &ctf, opts);
+            for isa in Isa::supported() {
+                let got = b.render(isa, &sc);
+                let e = max_err(&got, &want);
+                eprintln!(
+                    "preint {preintegrated} cells {macrocells} {isa}: max error {e:.5} ({:.2}/255)",
+                    e * 255.0
+                );
+                assert!(
+                    e <= tol,
+                    "preint {preintegrated} cells {macrocells} {isa}: max error {e}"
+                );
+            }
+        }
+    }
+}
+
+fn shell_scene(format: VolumeFormat) -> (Volume, Macrocells) {
+    let mut a = shell(9.0);
+    let b = shell(13.0);
+    a.x.extend(b.x);
+    a.y.extend(b.y);
+    a.z.extend(b.z);
+    a.r.extend(b.r);
+    let p = DensityParams {
+        voxels_per_angstrom: 3.0,
+        format,
+        budget_bytes: None,
+    };
+    let v = build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p).unwrap();
+    let mc = Macrocells::build(&v);
+    (v, mc)
+}
+
+/// Random rays from outside a 40 Å box towards random points near the origin; a quarter
+/// with a finite opaque depth.
+fn scattered_rays(n: usize, seed: u64) -> Batch {
+    let mut rng = Rng(seed);
+    let mut b = Batch::new();
+    for i in 0..n {
+        let o = [
+            rng.range(-25.0, 25.0),
+            rng.range(-25.0, 25.0),
+            30.0 * if i % 2 == 0 { 1.0 } else { -1.0 },
+        ];
+        let target = [
+            rng.range(-15.0, 15.0),
+            rng.range(-15.0, 15.0),
+            rng.range(-15.0, 15.0),
+        ];
+        let d: [f64; 3] = core::array::from_fn(|a| target[a] - o[a]);
+        let tmax = if i % 4 == 1 {
+            rng.range(0.3, 1.2) as f32
+        } else {
+            f32::INFINITY
+        };
+        b.push(o, d, tmax);
+    }
+    // Axis-aligned and inside-the-volume origins, the DDA's edge cases.
+    b.push([0.1, 0.2, -40.0], [0.0, 0.0, 1.0], f32::INFINITY);
+    b.push([-40.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
+    b.push([0.0, 3.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY);
+    b.push([9.5, 0.0, 0.0], [0.3, 0.5, -0.2], f32::INFINITY);
+    b.push([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 0.0);
+    b
+}
+
+fn all_opts() -> Vec<MarchOptions> {
+    let mut v = vec![];
+    for preintegrated in [true, false] {
+        for lighting in [
+            Lighting::Unlit,
+            Lighting::Headlight,
+            Lighting::Directional([1.0, 2.0, 0.5]),
+        ] {
+            v.push(MarchOptions {
+                preintegrated,
+                lighting,
+                ..Default::default()
+            });
+        }
+    }
+    v
+}
+
+#[test]
+fn macrocell_skipping_matches_no_skipping_within_one_255th() {
+    for format in [VolumeFormat::U8, VolumeFormat::F32] {
+        let (v, mc) = shell_scene(format);
+        for preset in Preset::ALL {
+            let ctf = ClassifiedTf::new(&TransferFunction::preset(preset), 0.0, v.max_value, 0.5);
+            // The test means something only if most cells are empty under this TF.
+            let empty = (0..mc.minmax.len() / 2)
+                .filter(|&c| {
+                    let (b0, b1) = (ctf.bin(mc.minmax[2 * c]), ctf.bin(mc.minmax[2 * c + 1]));
+                    ctf.range_max[b0.saturating_sub(1) * 256 + (b1 + 1).min(255)] == 0.0
+                })
+                .count();
+            assert!(
+                empty * 4 > mc.minmax.len() / 2,
+                "{preset:?}: {empty} empty cells"
+            );
+            let b = scattered_rays(300, 3);
+            for opts in all_opts() {
+                let on = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
+                let off_opts = MarchOptions {
+                    macrocells: false,
+                    ..opts
+                };
+                let off = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, off_opts));
+                let mut worst = 0.0f32;
+                for (x, y) in on.iter().zip(&off) {
+                    for c in 0..4 {
+                        worst = worst.max((x[c] - y[c]).abs());
+                    }
+                }
+                assert!(
+                    worst <= 1.0 / 255.0,
+                    "{format} {preset:?} {opts:?}: {worst}"
+                );
+                assert!(off.iter().filter(|c| c[3] > 0.1).count() > 30);
+            }
+        }
+    }
+}
+
+#[test]
+fn every_backend_agrees_with_scalar() {
+    let (v, mc) = shell_scene(VolumeFormat::U8);
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::Viridis),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let b = scattered_rays(203, 9); // not a multiple of any lane count
+    for opts in all_opts().into_iter().flat_map(|o| {
+        [
+            o,
+            MarchOptions {
+                macrocells: false,
+                ..o
+            },
+        ]
+    }) {
+        let sc = VolumeScene::new(&v, &mc, &ctf, opts);
+        let want = b.render(Isa::Scalar, &sc);
+        for isa in Isa::supported() {
+            let got = b.render(isa, &sc);
+            for (i, (x, y)) in got.iter().zip(&want).enumerate() {
+                for c in 0..4 {
+                    assert!(
+                        (x[c] - y[c]).abs() <= 1e-5,
+                        "{isa} {opts:?} ray {i}: {x:?} vs scalar {y:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn opaque_depth_and_empty_transfer_function() {
+    let (v, mc) = shell_scene(VolumeFormat::F32);
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let sc = VolumeScene::new(&v, &mc, &ctf, MarchOptions::default());
+    let mut b = Batch::new();
+    // Straight through the centre along +x: crosses both shells twice.
+    for tmax in [f32::INFINITY, 30.0, 19.0, 0.0] {
+        b.push([-30.0, 0.3, 0.2], [1.0, 0.0, 0.0], tmax);
+    }
+    let out = b.render(Isa::detect(), &sc);
+    assert!(
+        out[0][3] > out[1][3] && out[1][3] > out[2][3] && out[2][3] > 0.0,
+        "{out:?}"
+    );
+    assert_eq!(out[3], [0.0; 4]);
+    for c in &out {
+        assert!(c[3] <= 1.0 && c[..3].iter().all(|x| *x >= 0.0 && *x <= c[3] + 1e-6));
+    }
+    // Early termination: a very opaque TF stops at α ≥ 0.99 but never overshoots 1.
+    let dense = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::Grayscale).scale_opacity(5.0),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let out = b.render(
+        Isa::detect(),
+        &VolumeScene::new(&v, &mc, &dense, MarchOptions::default()),
+    );
+    assert!(out[0][3] >= 0.99 && out[0][3] <= 1.0, "{:?}", out[0]);
+    // A transparent TF renders nothing, with or without macrocells.
+    let none = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm).scale_opacity(0.0),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    for macrocells in [true, false] {
+        let opts = MarchOptions {
+            macrocells,
+            ..Default::default()
+        };
+        let out = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &none, opts));
+        assert!(out.iter().all(|c| *c == [0.0; 4]));
+    }
+}
+
+#[test]
+fn transfer_function_text_format() {
+    let text =
+        "# density ramp\n0.0 0 0 0.5 0\n\n0.2, 0, 0, 0.5, 0   # transparent\n1.0 1 0.8 0.2 0.3\n";
+    let tf = TransferFunction::parse(text, "ramp.tf").unwrap();
+    assert_eq!(tf.table.len(), 256);
+    assert_eq!(tf.table[0], [0.0, 0.0, 0.5, 0.0]);
+    assert_eq!(tf.table[255], [1.0, 0.8, 0.2, 0.3]);
+    assert_eq!(tf.table[51][3], 0.0); // 51/255 = 0.2
+    let mid = tf.table[153]; // 0.6: halfway from 0.2 to 1.0
+    assert!(
+        (mid[0] - 0.5).abs() < 1e-5 && (mid[3] - 0.15).abs() < 1e-5,
+        "{mid:?}"
+    );
+
+    let err = |t: &str| TransferFunction::parse(t, "x.tf").unwrap_err().to_string();
+    assert_eq!(
+        err("0 0 0 0 0\n0.5 1 1 1\n"),
+        "x.tf:2: expected 5 numbers `value r g b a`, found 4 field(s)"
+    );
+    assert_eq!(
+        err("0 0 0 0 0\n# c\n1 1 one 1 1\n"),
+        "x.tf:3: g: \"one\" is not a number"
+    );
+    assert_eq!(
+        err("0 0 0 0 1.5\n1 1 1 1 1\n"),
+        "x.tf:1: a = 1.5 is outside [0, 1]"
+    );
+    assert_eq!(
+        err("0.5 0 0 0 0\n0.25 1 1 1 1\n"),
+        "x.tf:2: value 0.25 is less than the previous point's 0.5: values must not decrease"
+    );
+    assert_eq!(
+        err("# only\n0 0 0 0 0\n"),
+        "x.tf: need at least 2 control points `value r g b a`, found 1"
+    );
+    assert!(err("0 0 0 0 NaN\n1 1 1 1 1\n").starts_with("x.tf:1:"));
+    let missing = TransferFunction::load(std::path::Path::new("/nonexistent/tf.txt")).unwrap_err();
+    assert!(missing.to_string().starts_with("/nonexistent/tf.txt: "));
+    for p in Preset::ALL {
+        assert_eq!(p.name().parse::<Preset>().unwrap(), p);
+    }
+}
+
+#[test]
+fn preintegration_of_a_constant_segment_is_the_post_classification() {
+    let tf = ramp_tf();
+    let c = ClassifiedTf::new(&tf, 0.0, 1.0, 0.5);
+    for i in [0usize, 60, 128, 200, 255] {
+        for ch in 0..4 {
+            let a = c.preint[(i * 256 + i) * 4 + ch];
+            let b = c.post[i * 4 + ch];
+            assert!((a - b).abs() < 1e-6, "bin {i} channel {ch}: {a} vs {b}");
+        }
+    }
+    // A rising segment is less opaque than its back value and more than its front one.
+    let (f, b) = (100usize, 220usize);
+    let a = c.preint[(f * 256 + b) * 4 + 3];
+    assert!(a > c.post[f * 4 + 3] && a < c.post[b * 4 + 3]);
+    // Order matters for colour (what is in front is seen first), not for opacity.
+    assert!((a - c.preint[(b * 256 + f) * 4 + 3]).abs() < 1e-6);
+    assert_ne!(c.preint[(f * 256 + b) * 4], c.preint[(b * 256 + f) * 4]);
+}
+
+#[test]
+fn batch_sampler_and_classifier_match_scalar_references() {
+    let (v, _) = shell_scene(VolumeFormat::U8);
+    let mut rng = Rng(5);
+    let n = 1001;
+    let pts: Vec<[f64; 3]> = (0..n)
+        .map(|_| {
+            [
+                rng.range(-17.0, 17.0),
+                rng.range(-17.0, 17.0),
+                rng.range(-17.0, 17.0),
+            ]
+        })
+        .collect();
+    let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = (
+        pts.iter().map(|p| p[0] as f32).collect(),
+        pts.iter().map(|p| p[1] as f32).collect(),
+        pts.iter().map(|p| p[2] as f32).collect(),
+    );
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::Viridis),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    for isa in Isa::supported() {
+        let mut out = vec![0.0; n];
+        sample_points(isa, &v, &x, &y, &z, &mut out);
+        for i in 0..n {
+            let p = [x[i] as f64, y[i] as f64, z[i] as f64];
+            let want = v.sample_trilinear(p);
+            assert!(
+                (out[i] as f64 - want).abs() <= 1e-5 * (1.0 + want),
+                "{isa} {p:?}: {} vs {want}",
+                out[i]
+            );
+        }
+        let mut rgba = vec![[0.0; 4]; n];
+        classify_values(isa, &ctf, &out, &mut rgba);
+        for i in 0..n {
+            let b = ctf.bin(out[i]);
+            assert_eq!(
+                rgba[i],
+                [
+                    ctf.post[4 * b],
+                    ctf.post[4 * b + 1],
+                    ctf.post[4 * b + 2],
+                    ctf.post[4 * b + 3]
+                ]
+            );
+        }
+    }
+}
+
+#[test]
+fn lighting_scales_colour_only() {
+    // One atom; lighting must leave opacity unchanged, never brighten, and on the axis
+    // through the centre the headlight sees the gradient head-on (almost no darkening).
+    let atoms = Atoms {
+        x: vec![0.0],
+        y: vec![0.0],
+        z: vec![0.0],
+        r: vec![1.5],
+    };
+    let p = DensityParams {
+        voxels_per_angstrom: 8.0,
+        format: VolumeFormat::F32,
+        budget_bytes: None,
+    };
+    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
+    let mc = Macrocells::build(&v);
+    let ctf = ClassifiedTf::new(&ramp_tf(), 0.0, v.max_value, 0.5);
+    let mut b = atom_rays(f32::INFINITY);
+    b.push([-8.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
+    let unlit = b.render(
+        Isa::detect(),
+        &VolumeScene::new(&v, &mc, &ctf, MarchOptions::default()),
+    );
+    let mut darker = 0;
+    for lighting in [Lighting::Headlight, Lighting::Directional([0.0, 1.0, 0.0])] {
+        let opts = MarchOptions {
+            lighting,
+            ..Default::default()
+        };
+        let lit = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
+        for (l, u) in lit.iter().zip(&unlit) {
+            assert!(
+                (l[3] - u[3]).abs() < 1e-6,
+                "{lighting:?}: opacity changed {l:?} vs {u:?}"
+            );
+            for c in 0..3 {
+                assert!(
+                    l[c] <= u[c] + 1e-6 && l[c] >= 0.3 * u[c] - 1e-6,
+                    "{lighting:?}: {l:?} vs {u:?}"
+                );
+            }
+            darker += (l[0] < 0.95 * u[0]) as usize;
+        }
+    }
+    assert!(
+        darker > 10,
+        "lighting must visibly shade some rays ({darker})"
+    );
+    let opts = MarchOptions {
+        lighting: Lighting::Headlight,
+        ..Default::default()
+    };
+    let lit = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
+    let (l, u) = (lit.last().unwrap(), unlit.last().unwrap());
+    assert!(
+        u[3] > 0.3 && l[0] > 0.9 * u[0],
+        "axis ray: lit {l:?} unlit {u:?}"
+    );
+}
+
+#[test]
+fn degenerate_rays_terminate_with_nothing() {
+    let (v, mc) = shell_scene(VolumeFormat::U8);
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let mut b = Batch::new();
+    b.push([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], f32::INFINITY); // zero direction
+    b.push([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
+    b.push([0.0, 0.0, 0.0], [1.0, f64::NAN, 0.0], f32::INFINITY);
+    b.push([-30.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::NAN);
+    b.push([-30.0, 0.0, 0.0], [1.0, 0.0, 0.0], -5.0);
+    b.push([-30.0, 0.0, 0.0], [-1.0, 0.0, 0.0], f32::INFINITY); // pointing away
+    b.push([-30.0, 0.0, 0.0], [1e-30, 0.0, 0.0], f32::INFINITY); // tiny direction
+    for opts in all_opts().into_iter().flat_map(|o| {
+        [
+            o,
+            MarchOptions {
+                macrocells: false,
+                ..o
+            },
+        ]
+    }) {
+        for isa in Isa::supported() {
+            let out = b.render(isa, &VolumeScene::new(&v, &mc, &ctf, opts));
+            for (i, c) in out.iter().enumerate().take(6) {
+                assert_eq!(*c, [0.0; 4], "{isa} {opts:?} ray {i}");
+            }
+            assert!(out[6].iter().all(|x| x.is_finite()));
+        }
+    }
+}

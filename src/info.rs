@@ -40,6 +40,9 @@ const BVH_NODE_BYTES: u64 = 32;
 
 /// Run `bnsview info`.
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
+    if args.input.file.is_none() && args.input.scene.is_none() {
+        anyhow::bail!("give a molecule FILE or --scene NAME (nanobowl, ns90k, ns740k, sio2, anp3)");
+    }
     let l = args.input.load(true)?;
     report(
         &args,

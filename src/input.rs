@@ -27,7 +27,7 @@ pub enum BondSource {
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
     /// Molecule file (xyz, pdb, lammps dump/data, gro; optionally .gz).
-    #[arg(required_unless_present = "scene", conflicts_with = "scene")]
+    #[arg(conflicts_with = "scene")]
     pub file: Option<PathBuf>,
     /// Built-in scene instead of a file: nanobowl, ns90k, ns740k, sio2, anp3.
     #[arg(long)]

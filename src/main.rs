@@ -8,6 +8,8 @@ mod generate;
 mod info;
 mod input;
 mod isa_cmd;
+mod pipeline;
+mod render_cmd;
 
 /// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,
 /// with SIMD kernels compiled for SSE4.1, AVX2 and AVX-512 and chosen at run time.
@@ -34,6 +36,8 @@ enum Command {
     /// Describe a molecule file or a built-in scene: atoms, frames, elements, bounds, bonds,
     /// memory estimates.
     Info(info::InfoArgs),
+    /// Render a molecule file or a built-in scene (default: nanobowl) to a PNG.
+    Render(Box<render_cmd::RenderArgs>),
     /// Write a built-in reference scene to a file (.xyz or .lammpstrj, optionally .gz).
     Generate(generate::GenerateArgs),
 }
@@ -58,6 +62,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Isa) => isa_cmd::run(isa),
         Some(Command::Info(args)) => info::run(args),
+        Some(Command::Render(args)) => render_cmd::run(*args, isa),
         Some(Command::Generate(args)) => generate::run(args),
         None => {
             use clap::CommandFactory;

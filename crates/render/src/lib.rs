@@ -15,7 +15,7 @@ pub use camera::{Camera, Projection, View};
 pub use colormap::{viridis, Colormap};
 pub use framebuffer::{Framebuffer, RenderError};
 pub use scene::{Coloring, Scene, SceneOptions, Style};
-pub use tile::{render_bs, render_bs_into, RenderOptions, RenderStats, TILE};
+pub use tile::{render_bs, render_bs_into, render_frame_into, RenderOptions, RenderStats, TILE};
 
 /// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
 pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {

@@ -5,6 +5,7 @@ use std::time::{Duration, Instant};
 use bvh::{surface, RayPacket};
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd, V3};
+use volume::VolumeScene;
 
 use crate::camera::{Camera, Projection};
 use crate::framebuffer::{Framebuffer, RenderError};
@@ -71,9 +72,36 @@ pub fn render_bs(
     Ok((fb, stats))
 }
 
+/// As [`render_bs_into`], with the passes of paper §4.2 chosen by what is given: the opaque
+/// ball-and-stick pass when `scene` is `Some`, then the volume pass when `volume` is `Some`,
+/// marched from the eye up to the opaque hit and composited in front of it
+/// (`volume` alone: the paper's "volume" mode; both: "vol+b&s").
+pub fn render_frame_into(
+    scene: Option<&Scene>,
+    volume: Option<&VolumeScene>,
+    camera: &Camera,
+    fb: &mut Framebuffer,
+    opt: &RenderOptions,
+    isa: Isa,
+) -> RenderStats {
+    render_tiles(scene, volume, camera, fb, opt, isa)
+}
+
 /// As [`render_bs`] into an existing frame (reuse it across frames).
 pub fn render_bs_into(
     scene: &Scene,
+    camera: &Camera,
+    fb: &mut Framebuffer,
+    opt: &RenderOptions,
+    isa: Isa,
+) -> RenderStats {
+    render_tiles(Some(scene), None, camera, fb, opt, isa)
+}
+
+/// The tile loop shared by every mode.
+fn render_tiles(
+    scene: Option<&Scene>,
+    volume: Option<&VolumeScene>,
     camera: &Camera,
     fb: &mut Framebuffer,
     opt: &RenderOptions,
@@ -96,6 +124,7 @@ pub fn render_bs_into(
                         let mut out = [0u32; TILE * TILE];
                         isa.dispatch(TileKernel {
                             scene,
+                            volume,
                             view: &view,
                             opt,
                             x0: tx * TILE,
@@ -176,7 +205,8 @@ impl ViewRays {
 }
 
 struct TileKernel<'a> {
-    scene: &'a Scene,
+    scene: Option<&'a Scene>,
+    volume: Option<&'a VolumeScene<'a>>,
     view: &'a ViewRays,
     opt: &'a RenderOptions,
     x0: usize,
@@ -225,9 +255,8 @@ impl Kernel for TileKernel<'_> {
 /// rays each, traced as one packet (§4.3), shaded with a headlight (§4.5 "b&s").
 #[inline(always)]
 fn render_tile<S: Simd, const N: usize>(s: S, k: &mut TileKernel<'_>) {
-    let bvh = &k.scene.bvh;
     let v = k.view;
-    let mut stack = vec![0u32; bvh.stack_size()];
+    let mut stack = vec![0u32; k.scene.map_or(0, |sc| sc.bvh.stack_size())];
     // One register covers bw × bh pixels; N registers a gw × gh grid of those.
     let bw = block_width(S::LANES);
     let bh = S::LANES / bw;
@@ -246,8 +275,6 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &mut TileKernel<'_>) {
     }
     let (lx, ly) = (s.load(&lx), s.load(&ly));
     let zero = s.splat(0.0);
-    let ambient = s.splat(k.opt.ambient);
-    let diffuse = s.splat(1.0 - k.opt.ambient);
     let bg = s.splat_i(k.opt.background as i32);
     let du = V3::splat(s, v.du);
     let dv = V3::splat(s, v.dv);
@@ -290,25 +317,26 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &mut TileKernel<'_>) {
             if !any {
                 continue;
             }
-            let hits = bvh.traverse_packets::<S, N>(s, &rays, &mut stack);
+            // Pass 1 (§4.2): opaque geometry, shaded; the hit depth bounds the volume pass.
+            // (No closure here: closures do not inherit the entry point's target features.)
+            #[allow(clippy::manual_map)]
+            let hits = match k.scene {
+                Some(sc) => Some(sc.bvh.traverse_packets::<S, N>(s, &rays, &mut stack)),
+                None => None,
+            };
             for j in 0..N {
-                let (ray, hit) = (&rays[j], &hits[j]);
-                let m = hit.hit_mask(s) & ray.active;
-                let color = if s.any(m) {
-                    let srf = surface(s, &bvh.records, ray.o, ray.d, hit.t, hit.slot, m);
-                    let zi = s.splat_i(0);
-                    let ca = s.gather_i(&k.scene.slot_color_a, hit.slot, m, zi);
-                    let cb = s.gather_i(&k.scene.slot_color_b, hit.slot, m, zi);
-                    let c = s.select_i(srf.second_half, cb, ca);
-                    // Headlight: the light is at the eye, so the cosine is |n·d|.
-                    let shade = ambient + diffuse * s.abs(srf.n.dot(ray.d));
-                    let rgb = channel(s, c, 0, shade)
-                        | channel(s, c, 8, shade)
-                        | channel(s, c, 16, shade)
-                        | s.splat_i(0xff << 24);
-                    s.select_i(m, rgb, bg)
-                } else {
-                    bg
+                let ray = &rays[j];
+                let (color, depth) = match (k.scene, &hits) {
+                    (Some(sc), Some(hits)) => shade_bs(s, sc, k.opt, ray, &hits[j], bg),
+                    _ => (bg, s.splat(f32::INFINITY)),
+                };
+                // Pass 2 (§4.2, §4.4): the volume in front of the opaque hit, composited over it.
+                let color = match k.volume {
+                    Some(vs) => {
+                        let c = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
+                        s.select_i(ray.active, over(s, c, color), color)
+                    }
+                    None => color,
                 };
                 s.store_i(color, &mut px_buf);
                 let (bx, by) = offs[j];
@@ -319,6 +347,52 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &mut TileKernel<'_>) {
             }
         }
     }
+}
+
+/// Headlight-shaded colour of the b&s hits of one packet (background where missed) and the
+/// hit depth (+inf where missed).
+#[inline(always)]
+fn shade_bs<S: Simd>(
+    s: S,
+    scene: &Scene,
+    opt: &RenderOptions,
+    ray: &RayPacket<S>,
+    hit: &bvh::PacketHit<S>,
+    bg: S::I32,
+) -> (S::I32, S::F32) {
+    let bvh = &scene.bvh;
+    let m = hit.hit_mask(s) & ray.active;
+    if s.none(m) {
+        return (bg, s.splat(f32::INFINITY));
+    }
+    let srf = surface(s, &bvh.records, ray.o, ray.d, hit.t, hit.slot, m);
+    let zi = s.splat_i(0);
+    let ca = s.gather_i(&scene.slot_color_a, hit.slot, m, zi);
+    let cb = s.gather_i(&scene.slot_color_b, hit.slot, m, zi);
+    let c = s.select_i(srf.second_half, cb, ca);
+    // Headlight: the light is at the eye, so the cosine is |n·d|.
+    let ambient = s.splat(opt.ambient);
+    let shade = ambient + s.splat(1.0 - opt.ambient) * s.abs(srf.n.dot(ray.d));
+    let rgb = channel(s, c, 0, shade)
+        | channel(s, c, 8, shade)
+        | channel(s, c, 16, shade)
+        | s.splat_i(0xff << 24);
+    (s.select_i(m, rgb, bg), s.select(m, hit.t, s.splat(f32::INFINITY)))
+}
+
+/// Premultiplied volume colour `c` (`[r, g, b, a]` in [0, 1]) over packed opaque colours
+/// `under`: `c·255 + (1 − a)·under` per channel, rounded; alpha 255.
+#[inline(always)]
+fn over<S: Simd>(s: S, c: [S::F32; 4], under: S::I32) -> S::I32 {
+    let t = s.splat(1.0) - c[3];
+    let mut out = s.splat_i(0xff << 24);
+    for (ch, shift) in [(0usize, 0u32), (1, 8), (2, 16)] {
+        let u = s.to_f32(s.shr(under, shift) & s.splat_i(255));
+        let v = s.fma(c[ch], s.splat(255.0), u * t) + s.splat(0.5);
+        let v = s.min(s.max(v, s.splat(0.0)), s.splat(255.0));
+        out = out | s.shl(s.to_i32(v), shift);
+    }
+    out
 }
 
 /// One 8-bit channel of packed colours `c` at bit `shift`, scaled by `shade` and rounded.

@@ -56,7 +56,11 @@ fn main() {
         }
         for _ in 0..10 {
             for (k, isa) in isas.iter().enumerate() {
-                times[k].push(render_bs_into(&scene, &cam, &mut fb, &ro, *isa).time.as_secs_f64());
+                times[k].push(
+                    render_bs_into(&scene, &cam, &mut fb, &ro, *isa)
+                        .time
+                        .as_secs_f64(),
+                );
             }
         }
         for (k, isa) in isas.iter().enumerate() {

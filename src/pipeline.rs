@@ -73,7 +73,11 @@ fn pack([r, g, b]: [u8; 3]) -> u32 {
 }
 
 /// The ball-and-stick scene of a molecule and its build time (s).
-pub fn build_scene(m: &Molecule, bonds: &[[u32; 2]], g: &GeometryArgs) -> anyhow::Result<(Scene, f64)> {
+pub fn build_scene(
+    m: &Molecule,
+    bonds: &[[u32; 2]],
+    g: &GeometryArgs,
+) -> anyhow::Result<(Scene, f64)> {
     let t = Instant::now();
     let radius: Vec<f32> = m
         .elements
@@ -86,7 +90,11 @@ pub fn build_scene(m: &Molecule, bonds: &[[u32; 2]], g: &GeometryArgs) -> anyhow
             }
         })
         .collect();
-    let colors: Vec<u32> = m.elements.iter().map(|&z| pack(elements::element(z).color)).collect();
+    let colors: Vec<u32> = m
+        .elements
+        .iter()
+        .map(|&z| pack(elements::element(z).color))
+        .collect();
     let coloring = if g.color == "element" {
         Coloring::PerAtom
     } else {
@@ -104,13 +112,23 @@ pub fn build_scene(m: &Molecule, bonds: &[[u32; 2]], g: &GeometryArgs) -> anyhow
             "gray" | "grey" => Colormap::Gray,
             other => anyhow::bail!("--colormap {other}: expected viridis or gray"),
         };
-        Coloring::Scalar { values: values.to_vec(), colormap, range: None }
+        Coloring::Scalar {
+            values: values.to_vec(),
+            colormap,
+            range: None,
+        }
     };
     if !(g.radius_scale > 0.0 && g.radius_scale.is_finite()) {
-        anyhow::bail!("--radius-scale must be a positive number, got {}", g.radius_scale);
+        anyhow::bail!(
+            "--radius-scale must be a positive number, got {}",
+            g.radius_scale
+        );
     }
     if !(g.stick_radius > 0.0 && g.stick_radius.is_finite()) {
-        anyhow::bail!("--stick-radius must be a positive number of Å, got {}", g.stick_radius);
+        anyhow::bail!(
+            "--stick-radius must be a positive number of Å, got {}",
+            g.stick_radius
+        );
     }
     let opt = SceneOptions {
         radius_scale: g.radius_scale,
@@ -127,12 +145,28 @@ pub fn build_scene(m: &Molecule, bonds: &[[u32; 2]], g: &GeometryArgs) -> anyhow
 }
 
 /// The density volume of a molecule with its macrocells, and the build time (s).
-pub fn build_volume(isa: Isa, m: &Molecule, v: &VolumeArgs) -> anyhow::Result<(Volume, Macrocells, f64)> {
+pub fn build_volume(
+    isa: Isa,
+    m: &Molecule,
+    v: &VolumeArgs,
+) -> anyhow::Result<(Volume, Macrocells, f64)> {
     let t = Instant::now();
-    let format: VolumeFormat = v.volume_format.parse().map_err(|e| anyhow::anyhow!("--volume-format: {e}"))?;
-    let r: Vec<f32> = m.elements.iter().map(|&z| elements::element(z).covalent_radius).collect();
-    let params = DensityParams { voxels_per_angstrom: v.voxels_per_angstrom, format, budget_bytes: None };
-    let vol = build_density(isa, &m.x, &m.y, &m.z, &r, &params).context("building the density volume")?;
+    let format: VolumeFormat = v
+        .volume_format
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--volume-format: {e}"))?;
+    let r: Vec<f32> = m
+        .elements
+        .iter()
+        .map(|&z| elements::element(z).covalent_radius)
+        .collect();
+    let params = DensityParams {
+        voxels_per_angstrom: v.voxels_per_angstrom,
+        format,
+        budget_bytes: None,
+    };
+    let vol =
+        build_density(isa, &m.x, &m.y, &m.z, &r, &params).context("building the density volume")?;
     let cells = Macrocells::build(&vol);
     Ok((vol, cells, t.elapsed().as_secs_f64()))
 }

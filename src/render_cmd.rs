@@ -100,7 +100,9 @@ pub struct RenderArgs {
 
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 1024x1024"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 1024x1024"))?;
     let p = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
     match (p(w), p(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
@@ -117,7 +119,11 @@ fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
 }
 
 fn parse_vec3(key: &str, v: &str) -> Result<[f32; 3]> {
-    let c: Vec<f32> = v.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().with_context(|| format!("--camera {key}={v}: expected three numbers x,y,z"))?;
+    let c: Vec<f32> = v
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--camera {key}={v}: expected three numbers x,y,z"))?;
     match c.as_slice() {
         [x, y, z] if c.iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
         _ => bail!("--camera {key}={v}: expected three finite numbers x,y,z"),
@@ -126,15 +132,35 @@ fn parse_vec3(key: &str, v: &str) -> Result<[f32; 3]> {
 
 /// Parses `--camera eye=..:at=..[:up=..][:fov=..][:ortho=..]`.
 pub fn parse_camera(spec: &str) -> Result<Camera> {
-    let (mut eye, mut at, mut up, mut fov, mut ortho) = (None, None, [0.0, 1.0, 0.0], 45.0f32, None);
+    let (mut eye, mut at, mut up, mut fov, mut ortho) =
+        (None, None, [0.0, 1.0, 0.0], 45.0f32, None);
     for part in spec.split(':').filter(|p| !p.trim().is_empty()) {
-        let (k, v) = part.split_once('=').with_context(|| format!("--camera: {part:?} is not key=value"))?;
+        let (k, v) = part
+            .split_once('=')
+            .with_context(|| format!("--camera: {part:?} is not key=value"))?;
         match k.trim() {
             "eye" => eye = Some(parse_vec3(k, v)?),
             "at" => at = Some(parse_vec3(k, v)?),
             "up" => up = parse_vec3(k, v)?,
-            "fov" => fov = v.trim().parse().ok().filter(|f: &f32| *f > 0.0 && *f < 180.0).with_context(|| format!("--camera fov={v}: expected degrees in (0, 180)"))?,
-            "ortho" => ortho = Some(v.trim().parse::<f32>().ok().filter(|h| *h > 0.0).with_context(|| format!("--camera ortho={v}: expected a positive height in Å"))?),
+            "fov" => {
+                fov = v
+                    .trim()
+                    .parse()
+                    .ok()
+                    .filter(|f: &f32| *f > 0.0 && *f < 180.0)
+                    .with_context(|| format!("--camera fov={v}: expected degrees in (0, 180)"))?
+            }
+            "ortho" => {
+                ortho = Some(
+                    v.trim()
+                        .parse::<f32>()
+                        .ok()
+                        .filter(|h| *h > 0.0)
+                        .with_context(|| {
+                            format!("--camera ortho={v}: expected a positive height in Å")
+                        })?,
+                )
+            }
             other => bail!("--camera: unknown key {other:?} (expected eye, at, up, fov, ortho)"),
         }
     }
@@ -164,7 +190,10 @@ pub fn load_tf(spec: &str) -> Result<TransferFunction> {
 /// Run `bnsview render`.
 pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     if let Some(n) = args.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global().context("--threads")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+            .context("--threads")?;
     }
     if args.lit && args.mode == Mode::Bs {
         bail!("--lit lights the volume: use it with --mode volume or --mode vol+bs");
@@ -175,7 +204,10 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     }
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = match (&input.file, input.scene) {
-            (Some(f), _) => f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bnsview".into()),
+            (Some(f), _) => f
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "bnsview".into()),
             (None, Some(sc)) => sc.to_string(),
             _ => "bnsview".into(),
         };
@@ -186,14 +218,22 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     }
     if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
-            bail!("cannot write {}: directory {} does not exist", output.display(), dir.display());
+            bail!(
+                "cannot write {}: directory {} does not exist",
+                output.display(),
+                dir.display()
+            );
         }
     }
     // Check the frame fits before the expensive preprocessing.
     let (w, h) = args.size;
     let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
     drop(probe);
-    let tf = if args.mode == Mode::Bs { None } else { Some(load_tf(&args.tf)?) };
+    let tf = if args.mode == Mode::Bs {
+        None
+    } else {
+        Some(load_tf(&args.tf)?)
+    };
 
     let l = input.load(false)?;
     let m = &l.molecule;
@@ -205,9 +245,22 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             eprintln!("{msg}");
         }
     };
-    verbose(format!("isa:     {isa} ({} lanes), {} threads", isa.lanes(), rayon::current_num_threads()));
-    verbose(format!("load:    {:.3} s  {} ({} atoms)", l.load_s, l.source, m.len()));
-    verbose(format!("bonds:   {:.3} s  {} bonds", l.bond_s, l.bonds.len()));
+    verbose(format!(
+        "isa:     {isa} ({} lanes), {} threads",
+        isa.lanes(),
+        rayon::current_num_threads()
+    ));
+    verbose(format!(
+        "load:    {:.3} s  {} ({} atoms)",
+        l.load_s,
+        l.source,
+        m.len()
+    ));
+    verbose(format!(
+        "bonds:   {:.3} s  {} bonds",
+        l.bond_s,
+        l.bonds.len()
+    ));
 
     let scene = if args.mode == Mode::Volume {
         None
@@ -247,8 +300,14 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         (None, Some((v, _))) => {
             let lo = v.grid.origin;
             let hi = v.grid.max_corner();
-            let c = [(lo[0] + hi[0]) * 0.5, (lo[1] + hi[1]) * 0.5, (lo[2] + hi[2]) * 0.5];
-            let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt() * 0.5;
+            let c = [
+                (lo[0] + hi[0]) * 0.5,
+                (lo[1] + hi[1]) * 0.5,
+                (lo[2] + hi[2]) * 0.5,
+            ];
+            let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
+                .sqrt()
+                * 0.5;
             (c, r)
         }
         _ => unreachable!("every mode draws geometry or volume"),
@@ -278,14 +337,21 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             MarchOptions {
                 macrocells: !args.no_macrocells,
                 preintegrated: !args.no_preintegration,
-                lighting: if args.lit { Lighting::Headlight } else { Lighting::Unlit },
+                lighting: if args.lit {
+                    Lighting::Headlight
+                } else {
+                    Lighting::Unlit
+                },
                 ..MarchOptions::default()
             },
         )),
         _ => None,
     };
     let [r, g, b] = args.background;
-    let opt = RenderOptions { background: render::rgba(r, g, b, 255), ..RenderOptions::default() };
+    let opt = RenderOptions {
+        background: render::rgba(r, g, b, 255),
+        ..RenderOptions::default()
+    };
     let mut fb = Framebuffer::new(w, h, opt.background)?;
     let t = Instant::now();
     let stats = render_frame_into(scene.as_ref(), vscene.as_ref(), &camera, &mut fb, &opt, isa);
@@ -298,7 +364,12 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         stats.mrays_per_s(),
         stats.fps()
     ));
-    fb.save_png(&output).with_context(|| format!("writing {}", output.display()))?;
-    eprintln!("wrote {} ({w}x{h}, {}, {isa})", output.display(), args.mode.name());
+    fb.save_png(&output)
+        .with_context(|| format!("writing {}", output.display()))?;
+    eprintln!(
+        "wrote {} ({w}x{h}, {}, {isa})",
+        output.display(),
+        args.mode.name()
+    );
     Ok(())
 }

@@ -377,7 +377,10 @@ fn shade_bs<S: Simd>(
         | channel(s, c, 8, shade)
         | channel(s, c, 16, shade)
         | s.splat_i(0xff << 24);
-    (s.select_i(m, rgb, bg), s.select(m, hit.t, s.splat(f32::INFINITY)))
+    (
+        s.select_i(m, rgb, bg),
+        s.select(m, hit.t, s.splat(f32::INFINITY)),
+    )
 }
 
 /// Premultiplied volume colour `c` (`[r, g, b, a]` in [0, 1]) over packed opaque colours

@@ -170,3 +170,17 @@ pub fn build_volume(
     let cells = Macrocells::build(&vol);
     Ok((vol, cells, t.elapsed().as_secs_f64()))
 }
+
+/// Bounding sphere of the atom centres (centre of the bounding box, Å) grown by `pad` Å.
+pub fn bounding_sphere(m: &Molecule, pad: f32) -> ([f32; 3], f32) {
+    let (lo, hi) = m.bounds();
+    let c = [
+        (lo[0] + hi[0]) * 0.5,
+        (lo[1] + hi[1]) * 0.5,
+        (lo[2] + hi[2]) * 0.5,
+    ];
+    let r2 = (0..m.len())
+        .map(|i| (m.x[i] - c[0]).powi(2) + (m.y[i] - c[1]).powi(2) + (m.z[i] - c[2]).powi(2))
+        .fold(0.0f32, f32::max);
+    (c, r2.sqrt() + pad)
+}

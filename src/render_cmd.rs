@@ -70,9 +70,9 @@ pub struct RenderArgs {
     /// Vertical field of view of the presets (degrees).
     #[arg(long, default_value_t = 45.0)]
     pub fov: f32,
-    /// Background colour `r,g,b` (0-255).
-    #[arg(long, default_value = "255,255,255", value_parser = parse_rgb)]
-    pub background: [u8; 3],
+    /// Background colour `r,g,b` (0-255; default white for bs, near-black for volume modes).
+    #[arg(long, value_parser = parse_rgb)]
+    pub background: Option<[u8; 3]>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     #[command(flatten)]
@@ -293,24 +293,11 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         ));
         Some((vol, cells))
     };
-    // Fit the camera to the scene's bounding sphere (the volume's box when there is no
-    // geometry).
-    let (center, radius) = match (&scene, &vol) {
-        (Some(sc), _) => (sc.center, sc.radius),
-        (None, Some((v, _))) => {
-            let lo = v.grid.origin;
-            let hi = v.grid.max_corner();
-            let c = [
-                (lo[0] + hi[0]) * 0.5,
-                (lo[1] + hi[1]) * 0.5,
-                (lo[2] + hi[2]) * 0.5,
-            ];
-            let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
-                .sqrt()
-                * 0.5;
-            (c, r)
-        }
-        _ => unreachable!("every mode draws geometry or volume"),
+    // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
+    // support, when there is no geometry).
+    let (center, radius) = match &scene {
+        Some(sc) => (sc.center, sc.radius),
+        None => crate::pipeline::bounding_sphere(m, 2.0),
     };
     let camera = match &args.camera {
         Some(spec) => parse_camera(spec)?,
@@ -347,7 +334,11 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         )),
         _ => None,
     };
-    let [r, g, b] = args.background;
+    let [r, g, b] = args.background.unwrap_or(if args.mode == Mode::Bs {
+        [255, 255, 255]
+    } else {
+        [12, 12, 20]
+    });
     let opt = RenderOptions {
         background: render::rgba(r, g, b, 255),
         ..RenderOptions::default()

@@ -76,3 +76,69 @@ fn unsupported_or_unknown_isa_is_a_clear_error() {
         "{out}"
     );
 }
+
+/// A fresh directory for one test's files.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("bnsview-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn render_writes_a_png_of_the_scene_and_never_overwrites_unasked() {
+    let d = scratch("render");
+    let out = d.join("bowl.png");
+    let args = [
+        "render", "--scene", "nanobowl", "--atoms", "3000", "--size", "96x64", "-o",
+    ];
+    let (ok, _, err) = run(bnsview().args(args).arg(&out));
+    assert!(ok, "{err}");
+    let img = image::open(&out).expect("a PNG").to_rgba8();
+    assert_eq!(img.dimensions(), (96, 64));
+    // The far view frames the molecule: background at the corners, geometry at the centre.
+    assert_eq!(img.get_pixel(0, 0).0, [255, 255, 255, 255]);
+    let drawn = img.pixels().filter(|p| p.0 != [255, 255, 255, 255]).count();
+    assert!(
+        drawn > 96 * 64 / 10,
+        "only {drawn} pixels show the molecule"
+    );
+    let before = std::fs::read(&out).unwrap();
+    let (ok, _, err) = run(bnsview().args(args).arg(&out).args(["--mode", "volume"]));
+    assert!(!ok && err.contains("--force"), "{err}");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        before,
+        "the existing file was changed"
+    );
+    let (ok, _, err) = run(bnsview()
+        .args(args)
+        .arg(&out)
+        .args(["--mode", "vol+bs", "--force"]));
+    assert!(ok, "{err}");
+    assert_ne!(std::fs::read(&out).unwrap(), before);
+}
+
+#[test]
+fn render_reports_bad_input_with_file_and_line() {
+    let d = scratch("bad");
+    let f = d.join("broken.xyz");
+    std::fs::write(&f, "3\ncomment\nC 0 0 0\nO 1.2 nope 0\nH 0 1 0\n").unwrap();
+    let (ok, _, err) = run(bnsview()
+        .arg("render")
+        .arg(&f)
+        .arg("-o")
+        .arg(d.join("x.png")));
+    assert!(!ok);
+    assert!(
+        err.contains("broken.xyz:4:") && err.contains("expected a number"),
+        "{err}"
+    );
+    assert!(!d.join("x.png").exists());
+    let (ok, _, err) = run(bnsview().args(["render", "--size", "0x10"]));
+    assert!(!ok && err.contains("positive"), "{err}");
+    let (ok, _, err) = run(bnsview()
+        .args(["render", "--camera", "eye=0,0,0:at=0,0,0", "-o"])
+        .arg(d.join("y.png")));
+    assert!(!ok && err.contains("same point"), "{err}");
+}

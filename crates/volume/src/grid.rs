@@ -269,7 +269,7 @@ fn check_atoms(x: &[f32], y: &[f32], z: &[f32], r: &[f32]) -> Result<(), VolumeE
 const SLAB: usize = 4;
 
 /// Bytes the build will hold at its peak for `grid` in `format`: the voxels (+4 bytes of
-/// padding), the macrocell grid, and for u8 one f32 slab per worker thread.
+/// padding), the macrocell grid, and one f32 block (4 planes × 32 rows) per worker thread.
 pub fn estimate_bytes(grid: &Grid, format: VolumeFormat) -> u64 {
     let voxels = grid
         .voxel_count()
@@ -282,11 +282,8 @@ pub fn estimate_bytes(grid: &Grid, format: VolumeFormat) -> u64 {
                 .max(1),
         )
     });
-    let slab = (SLAB * grid.dims[0] * grid.dims[1]) as u64 * 4;
-    let scratch = match format {
-        VolumeFormat::U8 => slab * rayon::current_num_threads() as u64,
-        VolumeFormat::F32 => 0,
-    };
+    let block = (SLAB * YBLOCK * grid.dims[0]) as u64 * 4;
+    let scratch = block * rayon::current_num_threads() as u64;
     voxels
         .saturating_add(cells.saturating_mul(8))
         .saturating_add(scratch)

@@ -600,3 +600,12 @@ fn degenerate_rays_terminate_with_nothing() {
         }
     }
 }
+
+#[test]
+fn shipped_transfer_function_file_parses() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tf/density-ramp.tf");
+    let tf = TransferFunction::load(&path).unwrap();
+    assert_eq!(tf.table[0][3], 0.0);
+    assert!((tf.table[255][3] - 0.35).abs() < 1e-6);
+    assert!(tf.table.windows(2).all(|w| w[1][3] >= w[0][3]));
+}

@@ -609,3 +609,22 @@ fn shipped_transfer_function_file_parses() {
     assert!((tf.table[255][3] - 0.35).abs() < 1e-6);
     assert!(tf.table.windows(2).all(|w| w[1][3] >= w[0][3]));
 }
+
+#[test]
+fn preintegration_table_matches_double_precision_integral() {
+    let tf = ramp_tf();
+    let c = ClassifiedTf::new(&tf, 0.0, 1.0, 0.5);
+    let mut rng = Rng(17);
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        let (f, b) = (
+            (rng.next_u64() % 256) as usize,
+            (rng.next_u64() % 256) as usize,
+        );
+        let want = preintegrate(&tf, f as f64, b as f64, 0.5);
+        for (ch, w) in want.iter().enumerate() {
+            worst = worst.max((c.preint[(f * 256 + b) * 4 + ch] as f64 - w).abs());
+        }
+    }
+    assert!(worst < 2e-4, "table vs f64 integral: {worst}");
+}

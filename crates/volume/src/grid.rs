@@ -1,5 +1,6 @@
 //! The RBF density grid (paper §3.1): Φ(x) = Σᵢ √rᵢ·exp(−d²/rᵢ²) for d < √2·rᵢ, sampled at
 //! the lattice points of a regular grid, built in parallel over z-slabs with SIMD along x.
+//! Values are f32 sums (atoms in a fixed order), optionally quantised to u8.
 //!
 //! ## Sampling convention
 //! Values live at **lattice points** (voxel corners): sample `(i, j, k)` is Φ at
@@ -300,10 +301,13 @@ pub fn default_budget_bytes() -> Option<u64> {
 /// Builds the density volume of the atoms (positions `x, y, z` and covalent radii `r`, Å)
 /// on [`Grid::for_atoms`] at `params.voxels_per_angstrom`, using backend `isa`.
 ///
+/// Work: atoms are binned by z-slab (4 lattice planes) and sorted by (y-band, x); rayon runs
+/// one task per slab, which computes the slab in y-blocks of 32 rows (an f32 scratch that
+/// stays in L2) with SIMD along x, then copies (f32) or quantises (u8) the block out.
+///
 /// Deterministic: every voxel sums its atoms in a fixed order (by y-band, x, index) whatever
-/// the thread count, so
-/// the result depends only on the inputs and the ISA (AVX2/AVX-512 fuse multiply-adds in
-/// `exp`, which changes the last bits).
+/// the thread count, so the result depends only on the inputs and the ISA (AVX2/AVX-512 fuse
+/// multiply-adds in `exp`, which changes the last bits).
 ///
 /// Errors: inconsistent or non-finite input, or [`VolumeError::TooLarge`] (with a suggested
 /// resolution) when [`estimate_bytes`] exceeds the budget or the voxel count exceeds what

@@ -1,1 +1,73 @@
-fn main() {}
+//! `bnsview`: ray tracing of large molecular-dynamics data on CPUs (see README.md).
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use spmd::Isa;
+
+mod generate;
+mod info;
+mod input;
+mod isa_cmd;
+mod pipeline;
+mod render_cmd;
+
+/// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,
+/// with SIMD kernels compiled for SSE4.1, AVX2 and AVX-512 and chosen at run time.
+#[derive(Parser, Debug)]
+#[command(name = "bnsview", disable_version_flag = true)]
+struct Cli {
+    /// Print the version and the instruction set that would be used, then exit.
+    #[arg(short = 'V', long)]
+    version: bool,
+
+    /// SIMD backend: scalar, sse4.1, avx2 or avx512 (default: BNS_ISA, else the widest the
+    /// CPU supports).
+    #[arg(long, global = true, value_name = "ISA")]
+    isa: Option<Isa>,
+
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List the SIMD backends, whether this CPU supports each, and which one is selected.
+    Isa,
+    /// Describe a molecule file or a built-in scene: atoms, frames, elements, bounds, bonds,
+    /// memory estimates.
+    Info(info::InfoArgs),
+    /// Render a molecule file or a built-in scene (default: nanobowl) to a PNG.
+    Render(Box<render_cmd::RenderArgs>),
+    /// Write a built-in reference scene to a file (.xyz or .lammpstrj, optionally .gz).
+    Generate(generate::GenerateArgs),
+}
+
+fn main() {
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let isa = Isa::select(cli.isa)?;
+    if cli.version {
+        println!(
+            "bnsview {} (isa: {isa}, {} lanes)",
+            env!("CARGO_PKG_VERSION"),
+            isa.lanes()
+        );
+        return Ok(());
+    }
+    match cli.command {
+        Some(Command::Isa) => isa_cmd::run(isa),
+        Some(Command::Info(args)) => info::run(args),
+        Some(Command::Render(args)) => render_cmd::run(*args, isa),
+        Some(Command::Generate(args)) => generate::run(args),
+        None => {
+            use clap::CommandFactory;
+            Cli::command().print_help()?;
+            Ok(())
+        }
+    }
+}

@@ -1,1 +1,400 @@
-fn main() {}
+//! Project chores: `cargo xtask matrix [--quick]` runs the test suite once per ISA the CPU
+//! has (with `BNS_ISA` forced), the criterion kernel benches, and portable builds for
+//! `-C target-cpu=x86-64 / x86-64-v3 / x86-64-v4`, then prints one table.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+
+const ISAS: [&str; 4] = ["scalar", "sse4.1", "avx2", "avx512"];
+const CPUS: [&str; 3] = ["x86-64", "x86-64-v3", "x86-64-v4"];
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("matrix") => matrix(args[1..].iter().any(|a| a == "--quick")),
+        _ => {
+            eprintln!("usage: cargo xtask matrix [--quick]");
+            eprintln!("  matrix   tests per ISA, kernel benches with speedups over scalar,");
+            eprintln!("           builds for target-cpu x86-64 / x86-64-v3 / x86-64-v4");
+            eprintln!("  --quick  short bench runs (criterion --quick)");
+            std::process::exit(2)
+        }
+    }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(root());
+    c
+}
+
+/// Runs a command, echoing stdout/stderr to our stderr, and returns stdout + stderr.
+fn run_logged(mut cmd: Command, what: &str) -> Result<(bool, String)> {
+    eprintln!("xtask: {what}");
+    let out = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .output()
+        .with_context(|| what.to_string())?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    eprint!("{text}");
+    Ok((out.status.success(), text))
+}
+
+/// Sums "test result: … N passed; M failed" lines of `cargo test` output.
+fn count_tests(text: &str) -> (u64, u64) {
+    let mut passed = 0;
+    let mut failed = 0;
+    for line in text.lines().filter(|l| l.starts_with("test result:")) {
+        let num_before = |word: &str| -> u64 {
+            line.split(';')
+                .find(|part| part.trim_end().ends_with(word))
+                .and_then(|part| part.split_whitespace().rev().nth(1))
+                .and_then(|n| n.parse().ok())
+                .unwrap_or(0)
+        };
+        passed += num_before("passed");
+        failed += num_before("failed");
+    }
+    (passed, failed)
+}
+
+fn supported_isas() -> Result<Vec<String>> {
+    // Ask the product itself, so the matrix agrees with what users see.
+    let out = cargo()
+        .args([
+            "run",
+            "--release",
+            "--quiet",
+            "--bin",
+            "bnsview",
+            "--",
+            "isa",
+        ])
+        .env_remove("BNS_ISA")
+        .output()
+        .context("running bnsview isa")?;
+    if !out.status.success() {
+        bail!(
+            "bnsview isa failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    Ok(text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let cols: Vec<&str> = l.split_whitespace().collect();
+            (cols.get(2) == Some(&"yes")).then(|| cols[0].to_string())
+        })
+        .collect())
+}
+
+/// Median times (ns) of every criterion benchmark, keyed by (group, isa), read from
+/// `target/criterion/<group>/<isa>/new/estimates.json`.
+fn bench_medians() -> Result<BTreeMap<(String, String), f64>> {
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"));
+    let crit = dir.join("criterion");
+    let mut out = BTreeMap::new();
+    let Ok(groups) = std::fs::read_dir(&crit) else {
+        return Ok(out);
+    };
+    for g in groups.flatten() {
+        for isa in ISAS {
+            let f = g.path().join(isa).join("new").join("estimates.json");
+            if let Ok(text) = std::fs::read_to_string(&f) {
+                if let Some(ns) = json_number_after(&text, "\"median\"", "\"point_estimate\"") {
+                    out.insert(
+                        (
+                            g.file_name().to_string_lossy().into_owned(),
+                            isa.to_string(),
+                        ),
+                        ns,
+                    );
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The number following `key2` after the first `key1` in a JSON text (enough for
+/// criterion's flat estimates file, without a JSON dependency in xtask).
+fn json_number_after(text: &str, key1: &str, key2: &str) -> Option<f64> {
+    let rest = &text[text.find(key1)?..];
+    let rest = &rest[rest.find(key2)? + key2.len()..];
+    let rest = rest.trim_start().strip_prefix(':')?.trim_start();
+    let end = rest
+        .find(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c)))
+        .unwrap_or(rest.len());
+    rest[..end].parse().ok()
+}
+
+fn matrix(quick: bool) -> Result<()> {
+    let t0 = Instant::now();
+    let isas = supported_isas()?;
+    eprintln!("xtask: supported ISAs: {}", isas.join(", "));
+
+    // 1. The whole test suite once per ISA, that ISA forced.
+    let mut test_rows = Vec::new();
+    let mut all_ok = true;
+    for isa in &isas {
+        let mut c = cargo();
+        c.args(["test", "--release", "--workspace"])
+            .env("BNS_ISA", isa);
+        let (ok, text) = run_logged(
+            c,
+            &format!("cargo test --release --workspace (BNS_ISA={isa})"),
+        )?;
+        let (p, f) = count_tests(&text);
+        all_ok &= ok && f == 0;
+        test_rows.push((isa.clone(), p, f, ok));
+    }
+
+    // 2. Criterion kernel benches; each bench covers every supported ISA.
+    let mut c = cargo();
+    c.args(["bench", "--workspace", "--bench", "*", "--", "--noplot"]);
+    if quick {
+        c.arg("--quick");
+    }
+    c.env_remove("BNS_ISA");
+    let (bench_ok, _) = run_logged(c, "cargo bench --workspace (criterion)")?;
+    all_ok &= bench_ok;
+    let medians = bench_medians()?;
+
+    // 3. Code generation: every backend's entry points in the kernels bench must use that
+    //    backend's registers and call no vector op out of line (a generic op that was not
+    //    inlined into the `#[target_feature]` entry point would be a call).
+    let asm_rows = asm_check()?;
+    all_ok &= asm_rows.iter().all(|r| r.ok);
+
+    // 4. Portable builds: the same binary must select AVX-512 at run time whatever the
+    //    compile-time baseline (each target-cpu gets its own target dir).
+    let mut cpu_rows = Vec::new();
+    for cpu in CPUS {
+        // The default build is the x86-64 baseline; the others get their own target dir
+        // because RUSTFLAGS rebuild every dependency.
+        let (dir, flags) = if cpu == "x86-64" {
+            (root().join("target"), String::new())
+        } else {
+            (
+                root().join(format!("target-cpu-{cpu}")),
+                format!("-C target-cpu={cpu}"),
+            )
+        };
+        let mut c = cargo();
+        c.args(["build", "--release", "--bin", "bnsview", "--target-dir"])
+            .arg(&dir)
+            .env("RUSTFLAGS", flags);
+        let (ok, _) = run_logged(c, &format!("cargo build --release (target-cpu={cpu})"))?;
+        let selected = if ok {
+            let out = Command::new(dir.join("release").join("bnsview"))
+                .arg("--version")
+                .env_remove("BNS_ISA")
+                .output()?;
+            String::from_utf8_lossy(&out.stdout).trim().to_string()
+        } else {
+            "build failed".to_string()
+        };
+        let expect = isas.last().cloned().unwrap_or_default();
+        let good = ok && selected.contains(&format!("isa: {expect},"));
+        all_ok &= good;
+        cpu_rows.push((cpu, selected, good));
+    }
+
+    // The table.
+    println!();
+    println!(
+        "== cargo xtask matrix{} ({:.0} s) ==",
+        if quick { " --quick" } else { "" },
+        t0.elapsed().as_secs_f64()
+    );
+    println!("{:<8} {:>7} {:>7}  tests", "isa", "passed", "failed");
+    for (isa, p, f, ok) in &test_rows {
+        println!(
+            "{:<8} {:>7} {:>7}  {}",
+            isa,
+            p,
+            f,
+            if *ok && *f == 0 { "ok" } else { "FAILED" }
+        );
+    }
+    println!();
+    let groups: Vec<String> = {
+        let mut g: Vec<String> = medians.keys().map(|(g, _)| g.clone()).collect();
+        g.dedup();
+        g
+    };
+    print!("{:<24}", "bench (speedup vs scalar)");
+    for isa in &isas {
+        print!(" {isa:>14}");
+    }
+    println!();
+    for g in &groups {
+        print!("{g:<24}");
+        let base = medians.get(&(g.clone(), "scalar".to_string())).copied();
+        for isa in &isas {
+            match (medians.get(&(g.clone(), isa.clone())), base) {
+                (Some(&t), Some(b)) => print!(" {:>7.2}x {:>5}", b / t, fmt_ns(t)),
+                (Some(&t), None) => print!(" {:>14}", fmt_ns(t)),
+                _ => print!(" {:>14}", "-"),
+            }
+        }
+        println!();
+    }
+    println!();
+    println!(
+        "{:<8} {:>7} {:>9} {:>11}  asm of spmd entry points (kernels bench)",
+        "isa", "entries", "reg insns", "inner calls"
+    );
+    for r in &asm_rows {
+        println!(
+            "{:<8} {:>7} {:>9} {:>11}  {}",
+            r.isa,
+            r.entries,
+            r.wide,
+            r.bad_calls,
+            if r.ok { "ok" } else { "FAILED" }
+        );
+    }
+    println!();
+    println!("{:<10} {:<6} bnsview --version", "target-cpu", "ok");
+    for (cpu, sel, good) in &cpu_rows {
+        println!(
+            "{:<10} {:<6} {}",
+            cpu,
+            if *good { "ok" } else { "FAILED" },
+            sel
+        );
+    }
+    if !all_ok {
+        bail!("matrix: something failed (see above)");
+    }
+    Ok(())
+}
+
+struct AsmRow {
+    isa: &'static str,
+    entries: usize,
+    wide: usize,
+    bad_calls: usize,
+    ok: bool,
+}
+
+/// Disassembles the `spmd::x86::<isa>::entry` instances of the kernels bench binary with
+/// `objdump` and counts instructions on the backend's registers and calls into spmd or
+/// `core::arch` code (which would mean a vector op was not inlined).
+fn asm_check() -> Result<Vec<AsmRow>> {
+    let mut c = cargo();
+    c.args([
+        "bench",
+        "--bench",
+        "kernels",
+        "--no-run",
+        "--message-format=short",
+    ]);
+    let (ok, text) = run_logged(c, "cargo bench --bench kernels --no-run")?;
+    if !ok {
+        bail!("building the kernels bench failed");
+    }
+    let exe = text
+        .lines()
+        .find_map(|l| {
+            l.trim()
+                .strip_prefix("Executable ")
+                .and_then(|r| r.split('(').nth(1))
+                .map(|p| p.trim_end_matches(')'))
+        })
+        .context("finding the kernels bench executable in cargo's output")?;
+    let exe = root().join(exe);
+    let dump = Command::new("objdump")
+        .args(["-d", "--no-show-raw-insn", "-C"])
+        .arg(&exe)
+        .output()
+        .context("running objdump (Debian package binutils)")?;
+    let dump = String::from_utf8_lossy(&dump.stdout);
+    let mut rows = Vec::new();
+    for (isa, module, reg) in [
+        ("sse4.1", "sse41", "%xmm"),
+        ("avx2", "avx2", "%ymm"),
+        ("avx512", "avx512", "%zmm"),
+    ] {
+        let header = format!("<spmd::x86::{module}::entry");
+        let (mut entries, mut wide, mut bad) = (0, 0, 0);
+        let mut inside = false;
+        for line in dump.lines() {
+            if line.ends_with(">:") {
+                inside = line.contains(&header);
+                entries += inside as usize;
+                continue;
+            }
+            if !inside {
+                continue;
+            }
+            wide += line.contains(reg) as usize;
+            if line.contains("call")
+                && (line.contains("core_arch")
+                    || line.contains("<spmd::x86")
+                    || line.contains("as spmd::Simd"))
+            {
+                bad += 1;
+            }
+        }
+        rows.push(AsmRow {
+            isa,
+            entries,
+            wide,
+            bad_calls: bad,
+            ok: entries > 0 && wide > 0 && bad == 0,
+        });
+    }
+    Ok(rows)
+}
+
+fn fmt_ns(ns: f64) -> String {
+    if ns >= 1e6 {
+        format!("{:.1}ms", ns / 1e6)
+    } else if ns >= 1e3 {
+        format!("{:.0}us", ns / 1e3)
+    } else {
+        format!("{ns:.0}ns")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_cargo_test_summaries() {
+        let text = "test result: ok. 12 passed; 0 failed; 1 ignored\nfoo\ntest result: FAILED. 3 passed; 2 failed; 0 ignored";
+        assert_eq!(count_tests(text), (15, 2));
+    }
+
+    #[test]
+    fn reads_criterion_median() {
+        let j = r#"{"mean":{"point_estimate":5.0},"median":{"confidence_interval":{"lower_bound":1.0},"point_estimate":123.5e3,"standard_error":2.0}}"#;
+        assert_eq!(
+            json_number_after(j, "\"median\"", "\"point_estimate\""),
+            Some(123500.0)
+        );
+    }
+}

@@ -1,1 +1,23 @@
-//! render (under construction)
+//! Ball-and-stick rendering (paper §4.2, §4.5 "b&s"): scene assembly (styles, colouring), a
+//! pinhole or orthographic camera with the paper's `far`/`close` views (Table 3), 16×16 tiles
+//! scheduled by rayon, pixel blocks of `LANES` primary rays traced as one packet through the
+//! BVH, headlight diffuse shading, an RGBA8 framebuffer and PNG output.
+//!
+//! Units: positions and radii in Ångström (Å); field of view in degrees.
+
+mod camera;
+mod colormap;
+mod framebuffer;
+mod scene;
+mod tile;
+
+pub use camera::{Camera, Projection, View};
+pub use colormap::{viridis, Colormap};
+pub use framebuffer::{Framebuffer, RenderError};
+pub use scene::{Coloring, Scene, SceneOptions, Style};
+pub use tile::{render_bs, render_bs_into, render_frame_into, RenderOptions, RenderStats, TILE};
+
+/// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
+pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {
+    r as u32 | (g as u32) << 8 | (b as u32) << 16 | (a as u32) << 24
+}

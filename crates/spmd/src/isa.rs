@@ -75,7 +75,13 @@ impl Isa {
     }
 
     /// Whether this CPU and OS can run the backend (checked with CPUID, cached by std).
+    ///
+    /// `BNS_CPU_LIMIT=<isa>` makes every wider backend count as unsupported, to exercise the
+    /// "CPU lacks it" paths on a machine that has everything (tests and demos only).
     pub fn is_supported(self) -> bool {
+        if cpu_limit().is_some_and(|limit| self > limit) {
+            return false;
+        }
         match self {
             Isa::Scalar => true,
             #[cfg(target_arch = "x86_64")]
@@ -92,6 +98,20 @@ impl Isa {
     /// The backends this machine supports, narrowest first.
     pub fn supported() -> Vec<Isa> {
         Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()
+    }
+
+    /// The backends a test or benchmark should cover: the one named by `BNS_ISA` if set (so
+    /// `cargo xtask matrix` can force each in turn), else every supported backend.
+    ///
+    /// Panics with a clear message if `BNS_ISA` is unknown or unsupported: a test run asked
+    /// for something it cannot do must not pass silently.
+    pub fn under_test() -> Vec<Isa> {
+        match std::env::var("BNS_ISA") {
+            Ok(v) if !v.trim().is_empty() => {
+                vec![Isa::select(None).unwrap_or_else(|e| panic!("{e}"))]
+            }
+            _ => Isa::supported(),
+        }
     }
 
     /// The widest supported backend.
@@ -152,6 +172,16 @@ impl Isa {
             _ => panic!("{} is not available on this architecture", self.name()),
         }
     }
+}
+
+/// The `BNS_CPU_LIMIT` cap, read once.
+fn cpu_limit() -> Option<Isa> {
+    static LIMIT: std::sync::OnceLock<Option<Isa>> = std::sync::OnceLock::new();
+    *LIMIT.get_or_init(|| {
+        std::env::var("BNS_CPU_LIMIT")
+            .ok()
+            .and_then(|v| v.parse().ok())
+    })
 }
 
 impl fmt::Display for Isa {

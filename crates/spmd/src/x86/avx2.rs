@@ -423,6 +423,9 @@ pub(crate) fn dispatch<K: Kernel>(k: K) -> K::Output {
     unsafe { entry(s, k) }
 }
 
+// Not inlined: one call per task, and a named symbol whose assembly can be checked
+// (`cargo xtask asm`).
+#[inline(never)]
 #[target_feature(enable = "avx2,fma")]
 fn entry<K: Kernel>(s: Avx2, k: K) -> K::Output {
     k.run(s)

@@ -438,6 +438,9 @@ pub(crate) fn dispatch<K: Kernel>(k: K) -> K::Output {
     unsafe { entry(s, k) }
 }
 
+// Not inlined: one call per task, and a named symbol whose assembly can be checked
+// (`cargo xtask asm`).
+#[inline(never)]
 #[target_feature(enable = "avx512f,avx2,fma")]
 fn entry<K: Kernel>(s: Avx512, k: K) -> K::Output {
     k.run(s)

@@ -394,6 +394,9 @@ pub(crate) fn dispatch<K: Kernel>(k: K) -> K::Output {
     unsafe { entry(s, k) }
 }
 
+// Not inlined: one call per task, and a named symbol whose assembly can be checked
+// (`cargo xtask asm`).
+#[inline(never)]
 #[target_feature(enable = "sse4.1")]
 fn entry<K: Kernel>(s: Sse41, k: K) -> K::Output {
     k.run(s)

@@ -1,0 +1,92 @@
+//! Kernel benchmarks per ISA: ray-sphere batches, coherent packet traversal, BVH builds.
+//! Ids: `ray_sphere/<isa>`, `packet_traversal/<isa>`, `bvh_build/<builder>`.
+
+use std::hint::black_box;
+
+use bvh::scenes::{random_molecule, Rng};
+use bvh::{Bvh, Geometry, Ray};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use spmd::Isa;
+
+/// Primary rays of a `w × w` pinhole view of the whole scene, in 4×4 pixel blocks (so every
+/// backend's packets are neighbouring pixels).
+fn camera_rays(bvh: &Bvh, w: usize) -> Vec<Ray> {
+    let b = bvh.bounds;
+    let c = b.center();
+    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max);
+    let eye = [c[0], c[1], c[2] + 1.6 * ext];
+    let mut rays = Vec::with_capacity(w * w);
+    for by in (0..w).step_by(4) {
+        for bx in (0..w).step_by(4) {
+            for i in 0..16 {
+                let (x, y) = (bx + i % 4, by + i / 4);
+                let u = ((x as f32 + 0.5) / w as f32 - 0.5) * 0.8;
+                let v = (0.5 - (y as f32 + 0.5) / w as f32) * 0.8;
+                rays.push(Ray::new(eye, [u, v, -1.0]));
+            }
+        }
+    }
+    rays
+}
+
+fn ray_sphere(c: &mut Criterion) {
+    // 64 spheres, 4096 rays: the kernel alone (brute force, no BVH).
+    let mut rng = Rng(5);
+    let n = 64;
+    let xs: Vec<f32> = (0..n).map(|_| rng.range(-10.0, 10.0) as f32).collect();
+    let ys: Vec<f32> = (0..n).map(|_| rng.range(-10.0, 10.0) as f32).collect();
+    let zs: Vec<f32> = (0..n).map(|_| rng.range(-10.0, 10.0) as f32).collect();
+    let g = Geometry::from_atoms(&xs, &ys, &zs, &vec![1.0; n], &[], &[], 0.1);
+    let bvh = Bvh::build(&g);
+    let rays: Vec<Ray> = (0..4096)
+        .map(|_| {
+            let d = rng.dir();
+            Ray::new(
+                [0.0, 0.0, 40.0],
+                [d[0] as f32 * 0.3, d[1] as f32 * 0.3, -1.0],
+            )
+        })
+        .collect();
+    let mut grp = c.benchmark_group("ray_sphere");
+    grp.throughput(Throughput::Elements((rays.len() * n) as u64));
+    for isa in Isa::supported() {
+        grp.bench_function(isa.name(), |b| {
+            b.iter(|| black_box(bvh.intersect_chunk(isa, black_box(&rays), true)))
+        });
+    }
+    grp.finish();
+}
+
+fn packet_traversal(c: &mut Criterion) {
+    let g = random_molecule(100_000, false, 7);
+    let bvh = Bvh::build(&g);
+    let rays = camera_rays(&bvh, 256);
+    let mut grp = c.benchmark_group("packet_traversal");
+    grp.throughput(Throughput::Elements(rays.len() as u64));
+    grp.sample_size(20);
+    for isa in Isa::supported() {
+        grp.bench_function(isa.name(), |b| {
+            b.iter(|| black_box(bvh.intersect_chunk(isa, black_box(&rays), false)))
+        });
+    }
+    grp.finish();
+}
+
+fn bvh_build(c: &mut Criterion) {
+    let g = random_molecule(100_000, false, 7);
+    let mut grp = c.benchmark_group("bvh_build");
+    grp.throughput(Throughput::Elements(g.prim_count() as u64));
+    grp.sample_size(10);
+    grp.bench_function("binned", |b| {
+        b.iter(|| black_box(Bvh::build(black_box(&g))))
+    });
+    let small = random_molecule(20_000, false, 7);
+    grp.throughput(Throughput::Elements(small.prim_count() as u64));
+    grp.bench_function("full_sweep_20k_atoms", |b| {
+        b.iter(|| black_box(Bvh::build_full_sweep(black_box(&small))))
+    });
+    grp.finish();
+}
+
+criterion_group!(benches, ray_sphere, packet_traversal, bvh_build);
+criterion_main!(benches);

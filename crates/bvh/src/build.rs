@@ -1,0 +1,683 @@
+//! BVH builders: binned SAH, parallel over subtrees (the fast one), and the paper's full-sweep
+//! SAH over presorted lists (§4.1, the quality reference).
+
+use std::time::Instant;
+
+use glam::Vec3A;
+use rayon::prelude::*;
+
+use crate::geometry::{prim_refs, Aabb, Geometry, PrimRef};
+use crate::tree::{refs_bounds, Builder, Bvh, Node, INNER, LEAF_MAX};
+
+/// Most bins the binned builder supports.
+pub const MAX_BINS: usize = 32;
+/// Subtrees with at least this many primitives on both sides are built in parallel.
+const PAR_SUBTREE: usize = 4096;
+/// Nodes with at least this many primitives are binned in parallel.
+const PAR_BIN: usize = 1 << 16;
+
+/// Options of the binned SAH builder.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    /// Number of bins per axis (2..=[`MAX_BINS`]); small nodes use at most one bin per primitive.
+    pub bins: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions { bins: MAX_BINS }
+    }
+}
+
+/// A box for the builder's inner loops (SSE min/max through glam).
+#[derive(Clone, Copy)]
+struct BBox {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl BBox {
+    const EMPTY: BBox = BBox {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+    };
+    #[inline(always)]
+    fn union(self, o: BBox) -> BBox {
+        BBox {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
+    }
+    #[inline(always)]
+    fn of(r: &PrimRef) -> BBox {
+        BBox {
+            lo: r.lo3(),
+            hi: r.hi3(),
+        }
+    }
+    #[inline(always)]
+    fn grow(&mut self, p: Vec3A) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+    /// Half the surface area (the factor 2 does not change any SAH decision); 0 if empty.
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+    fn aabb(&self) -> Aabb {
+        Aabb {
+            min: self.lo.into(),
+            max: self.hi.into(),
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    b: BBox,
+    n: u32,
+}
+
+const EMPTY_BIN: Bin = Bin {
+    b: BBox::EMPTY,
+    n: 0,
+};
+
+type Bins = [[Bin; MAX_BINS]; 3];
+
+/// Where a primitive's (doubled) centroid falls along each axis.
+#[derive(Clone, Copy)]
+struct Binner {
+    min: Vec3A,
+    scale: Vec3A,
+    nb: usize,
+}
+
+impl Binner {
+    fn new(cb: &Aabb, nb: usize) -> Binner {
+        let mut scale = [0.0; 3];
+        for (k, s) in scale.iter_mut().enumerate() {
+            let ext = cb.max[k] - cb.min[k];
+            if ext > 0.0 && ext.is_finite() {
+                *s = nb as f32 * (1.0 - 1e-6) / ext;
+            }
+        }
+        Binner {
+            min: cb.min.into(),
+            scale: scale.into(),
+            nb,
+        }
+    }
+    /// Bin of `r` along every axis: `(c − min)·scale − ½`, clamped to `[0, nb − 1]` (NaN -> 0),
+    /// rounded to nearest by adding 2²³ and reading the low mantissa bits (no float-to-int
+    /// conversions). Binning and partitioning both use this, so they always agree.
+    #[inline(always)]
+    fn bins(&self, r: &PrimRef) -> [usize; 3] {
+        const MAGIC: f32 = 8_388_608.0;
+        let f = (r.c2() - self.min) * self.scale - Vec3A::splat(0.5);
+        let f = f.max(Vec3A::ZERO).min(Vec3A::splat((self.nb - 1) as f32)) + Vec3A::splat(MAGIC);
+        [
+            (f.x.to_bits() & 0xff) as usize,
+            (f.y.to_bits() & 0xff) as usize,
+            (f.z.to_bits() & 0xff) as usize,
+        ]
+    }
+    fn fill(&self, refs: &[PrimRef], bins: &mut Bins) {
+        for r in refs {
+            let b = BBox::of(r);
+            let idx = self.bins(r);
+            for k in 0..3 {
+                let bin = &mut bins[k][idx[k]];
+                bin.b = bin.b.union(b);
+                bin.n += 1;
+            }
+        }
+    }
+}
+
+fn merge_bins(mut a: Bins, b: &Bins) -> Bins {
+    for k in 0..3 {
+        for i in 0..MAX_BINS {
+            a[k][i].b = a[k][i].b.union(b[k][i].b);
+            a[k][i].n += b[k][i].n;
+        }
+    }
+    a
+}
+
+/// Result of splitting a node's refs in place: the left part is `refs[..nl]`.
+struct Split {
+    axis: u32,
+    nl: usize,
+    lb: Aabb,
+    lcb: Aabb,
+    rb: Aabb,
+    rcb: Aabb,
+}
+
+/// Nodes this small get an exact SAH sweep over sorted centroids instead of bins.
+const SMALL: usize = 16;
+const SMALL_ONE_AXIS: bool = true;
+
+/// Exact SAH split of a small node: sort along each axis, sweep, keep the best.
+fn split_small(refs: &mut [PrimRef], cb: &Aabb) -> Split {
+    let n = refs.len();
+    // Only the axis of largest centroid extent: a third of the work, SAH cost within 1%.
+    let ext = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
+    let kmax = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+        0
+    } else if ext[1] >= ext[2] {
+        1
+    } else {
+        2
+    };
+    let mut best = (f32::INFINITY, 0usize, n / 2);
+    let mut order = [[0u8; SMALL]; 3];
+    let mut rcost = [0.0f32; SMALL];
+    let mut keys = [[0.0f32; SMALL]; 3];
+    for (i, r) in refs.iter().enumerate() {
+        let c = r.c2();
+        keys[0][i] = c.x;
+        keys[1][i] = c.y;
+        keys[2][i] = c.z;
+    }
+    for (k, ord) in order.iter_mut().enumerate() {
+        if SMALL_ONE_AXIS && k != kmax {
+            continue;
+        }
+        let ord = &mut ord[..n];
+        for (i, o) in ord.iter_mut().enumerate() {
+            *o = i as u8;
+        }
+        // Insertion sort by key (n <= 16; NaN-free: centroids are sanitised to finite values).
+        let key = &keys[k];
+        for i in 1..n {
+            let v = ord[i];
+            let kv = key[v as usize];
+            let mut j = i;
+            while j > 0 && key[ord[j - 1] as usize] > kv {
+                ord[j] = ord[j - 1];
+                j -= 1;
+            }
+            ord[j] = v;
+        }
+        let mut acc = BBox::EMPTY;
+        for i in (1..n).rev() {
+            acc = acc.union(BBox::of(&refs[ord[i] as usize]));
+            rcost[i] = acc.half_area() * (n - i) as f32;
+        }
+        let mut acc = BBox::EMPTY;
+        for i in 1..n {
+            acc = acc.union(BBox::of(&refs[ord[i - 1] as usize]));
+            let cost = acc.half_area() * i as f32 + rcost[i];
+            if cost < best.0 {
+                best = (cost, k, i);
+            }
+        }
+    }
+    let (_, k, nl) = best;
+    let k = if SMALL_ONE_AXIS { kmax } else { k };
+    let mut tmp = [refs[0]; SMALL];
+    for (t, &o) in tmp.iter_mut().zip(&order[k][..n]) {
+        *t = refs[o as usize];
+    }
+    refs.copy_from_slice(&tmp[..n]);
+    let side = |rs: &[PrimRef]| {
+        let mut b = BBox::EMPTY;
+        let mut cb = BBox::EMPTY;
+        for r in rs {
+            b = b.union(BBox::of(r));
+            cb.grow(r.c2());
+        }
+        (b.aabb(), cb.aabb())
+    };
+    let (lb, lcb) = side(&refs[..nl]);
+    let (rb, rcb) = side(&refs[nl..]);
+    Split {
+        axis: k as u32,
+        nl,
+        lb,
+        lcb,
+        rb,
+        rcb,
+    }
+}
+
+/// Bins ready for a node: the binner they were made with and the bins.
+#[derive(Clone, Copy)]
+struct Binned {
+    binner: Binner,
+    bins: Bins,
+}
+
+/// Bins of `refs` (in parallel for large runs).
+fn compute_bins(refs: &[PrimRef], binner: &Binner) -> Bins {
+    if refs.len() >= PAR_BIN {
+        refs.par_chunks(1 << 14)
+            .fold(
+                || [[EMPTY_BIN; MAX_BINS]; 3],
+                |mut acc, c| {
+                    binner.fill(c, &mut acc);
+                    acc
+                },
+            )
+            .reduce(|| [[EMPTY_BIN; MAX_BINS]; 3], |a, b| merge_bins(a, &b))
+    } else {
+        let mut b = [[EMPTY_BIN; MAX_BINS]; 3];
+        binner.fill(refs, &mut b);
+        b
+    }
+}
+
+#[inline(always)]
+fn add_to(bins: &mut Bins, idx: [usize; 3], b: BBox) {
+    for (k, axis_bins) in bins.iter_mut().enumerate() {
+        let bin = &mut axis_bins[idx[k]];
+        bin.b = bin.b.union(b);
+        bin.n += 1;
+    }
+}
+
+/// Binned SAH split (§4.1 step 4, binned after Wald 2007): bins centroids along x, y and z
+/// (or takes the bins the parent made), sweeps the bins, and partitions `refs` in place.
+/// The partition pass also bins each child's primitives (with the child's centroid range
+/// estimated from the split plane), so every level reads the primitives once, not twice.
+fn split(
+    refs: &mut [PrimRef],
+    cb: &Aabb,
+    nb: usize,
+    pre: Option<Box<Binned>>,
+) -> (Split, Option<Box<Binned>>, Option<Box<Binned>>) {
+    let n = refs.len();
+    if n <= SMALL {
+        return (split_small(refs, cb), None, None);
+    }
+    let mut pre = pre.unwrap_or_else(|| {
+        let binner = Binner::new(cb, nb.clamp(2, MAX_BINS));
+        Box::new(Binned {
+            binner,
+            bins: compute_bins(refs, &binner),
+        })
+    });
+    let (binner, bins) = (pre.binner, &pre.bins);
+    let nb = binner.nb;
+
+    // Sweep: cost of splitting after bin i = A(left)·N(left) + A(right)·N(right).
+    let mut best: Option<(f32, usize, usize)> = None;
+    for (k, axis_bins) in bins.iter().enumerate() {
+        if binner.scale[k] == 0.0 {
+            continue;
+        }
+        let mut rcost = [0.0f32; MAX_BINS];
+        let mut rcount = [0u32; MAX_BINS];
+        let mut acc = BBox::EMPTY;
+        let mut cnt = 0u32;
+        for i in (1..nb).rev() {
+            acc = acc.union(axis_bins[i].b);
+            cnt += axis_bins[i].n;
+            rcost[i - 1] = acc.half_area() * cnt as f32;
+            rcount[i - 1] = cnt;
+        }
+        let mut acc = BBox::EMPTY;
+        let mut cnt = 0u32;
+        for i in 0..nb - 1 {
+            acc = acc.union(axis_bins[i].b);
+            cnt += axis_bins[i].n;
+            if cnt == 0 || rcount[i] == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f32 + rcost[i];
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, k, i));
+            }
+        }
+    }
+
+    let Some((_, k, pos)) = best else {
+        // Every centroid in the same place: split the run in the middle.
+        let nl = n / 2;
+        let (l, r) = refs.split_at(nl);
+        let s = Split {
+            axis: 0,
+            nl,
+            lb: refs_bounds(l),
+            lcb: *cb,
+            rb: refs_bounds(r),
+            rcb: *cb,
+        };
+        return (s, None, None);
+    };
+    let mut lb = BBox::EMPTY;
+    let mut rb = BBox::EMPTY;
+    for (i, bin) in bins[k][..nb].iter().enumerate() {
+        if i <= pos {
+            lb = lb.union(bin.b);
+        } else {
+            rb = rb.union(bin.b);
+        }
+    }
+    // Children's centroid ranges, estimated: the parent's, cut at the split plane.
+    let plane = binner.min[k] + (pos + 1) as f32 / binner.scale[k];
+    let (mut lcb_est, mut rcb_est) = (*cb, *cb);
+    lcb_est.max[k] = plane.min(cb.max[k]);
+    rcb_est.min[k] = plane.max(cb.min[k]);
+    let (lbinner, rbinner) = (Binner::new(&lcb_est, nb), Binner::new(&rcb_est, nb));
+    // The parent's bins are no longer needed: reuse their box for the left child.
+    pre.binner = lbinner;
+    pre.bins = [[EMPTY_BIN; MAX_BINS]; 3];
+    let mut lpre = pre;
+    let mut rpre = Box::new(Binned {
+        binner: rbinner,
+        bins: [[EMPTY_BIN; MAX_BINS]; 3],
+    });
+    let (lbins, rbins) = (&mut lpre.bins, &mut rpre.bins);
+    // Partition in place; every element is classified (and binned for its child) once.
+    let (mut i, mut j) = (0, n);
+    let mut lcb = BBox::EMPTY;
+    let mut rcb = BBox::EMPTY;
+    while i < j {
+        let r = refs[i];
+        let c = r.c2();
+        if binner.bins(&r)[k] <= pos {
+            lcb.grow(c);
+            add_to(lbins, lbinner.bins(&r), BBox::of(&r));
+            i += 1;
+        } else {
+            rcb.grow(c);
+            add_to(rbins, rbinner.bins(&r), BBox::of(&r));
+            j -= 1;
+            refs.swap(i, j);
+        }
+    }
+    let s = Split {
+        axis: k as u32,
+        nl: i,
+        lb: lb.aabb(),
+        lcb: lcb.aabb(),
+        rb: rb.aabb(),
+        rcb: rcb.aabb(),
+    };
+    (s, Some(lpre), Some(rpre))
+}
+
+/// The top of the tree, built in parallel: inner nodes down to subtrees small enough to build
+/// sequentially, each into its own exactly sized node array.
+enum Skeleton {
+    Inner {
+        bounds: Aabb,
+        axis: u32,
+        children: Box<(Skeleton, Skeleton)>,
+    },
+    /// A subtree: root at 0, children pairs adjacent, indices local to the array; leaves
+    /// hold global primitive slots.
+    Local(Vec<Node>),
+}
+
+/// Builds the tree over `refs` (primitive slots from `ref_base`): rayon over subtrees while
+/// both sides have at least [`PAR_SUBTREE`] primitives, then sequentially.
+fn build_skeleton(
+    refs: &mut [PrimRef],
+    ref_base: usize,
+    bounds: Aabb,
+    cb: Aabb,
+    nb: usize,
+    pre: Option<Box<Binned>>,
+) -> Skeleton {
+    let n = refs.len();
+    if n >= 2 * PAR_SUBTREE {
+        let (s, lpre, rpre) = split(refs, &cb, nb, pre);
+        let nl = s.nl;
+        let (lrefs, rrefs) = refs.split_at_mut(nl);
+        if nl >= PAR_SUBTREE && n - nl >= PAR_SUBTREE {
+            let (l, r) = rayon::join(
+                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, nb, lpre),
+                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre),
+            );
+            return Skeleton::Inner {
+                bounds,
+                axis: s.axis,
+                children: Box::new((l, r)),
+            };
+        }
+        // Too lopsided to fork: the split is done, build both sides here.
+        let mut nodes = Vec::with_capacity(n);
+        let mut root = Node::default();
+        root.set_aabb(&bounds);
+        root.first = 1;
+        root.meta = INNER | s.axis;
+        nodes.extend([root, Node::default(), Node::default()]);
+        build_seq(lrefs, ref_base, s.lb, s.lcb, nb, lpre, &mut nodes, 1);
+        build_seq(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, &mut nodes, 2);
+        return Skeleton::Local(nodes);
+    }
+    let mut nodes = Vec::with_capacity(n);
+    nodes.push(Node::default());
+    build_seq(refs, ref_base, bounds, cb, nb, pre, &mut nodes, 0);
+    Skeleton::Local(nodes)
+}
+
+/// Sequential build of the subtree of `refs` into `nodes[at]` (children pairs pushed at the
+/// end). Recurses into the smaller child and loops on the larger: stack depth O(log n).
+#[allow(clippy::too_many_arguments)]
+fn build_seq(
+    mut refs: &mut [PrimRef],
+    mut ref_base: usize,
+    mut bounds: Aabb,
+    mut cb: Aabb,
+    nb: usize,
+    mut pre: Option<Box<Binned>>,
+    nodes: &mut Vec<Node>,
+    mut at: usize,
+) {
+    loop {
+        nodes[at].set_aabb(&bounds);
+        let n = refs.len();
+        if n <= LEAF_MAX {
+            nodes[at].first = ref_base as u32;
+            nodes[at].meta = n as u32;
+            return;
+        }
+        let (s, lpre, rpre) = split(refs, &cb, nb, pre);
+        let (nl, nr) = (s.nl, n - s.nl);
+        let c = nodes.len();
+        nodes[at].first = c as u32;
+        nodes[at].meta = INNER | s.axis;
+        nodes.push(Node::default());
+        nodes.push(Node::default());
+        let (lrefs, rrefs) = std::mem::take(&mut refs).split_at_mut(nl);
+        if nl <= nr {
+            build_seq(lrefs, ref_base, s.lb, s.lcb, nb, lpre, nodes, c);
+            (refs, ref_base, bounds, cb, pre, at) =
+                (rrefs, ref_base + nl, s.rb, s.rcb, rpre, c + 1);
+        } else {
+            build_seq(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, nodes, c + 1);
+            (refs, ref_base, bounds, cb, pre, at) = (lrefs, ref_base, s.lb, s.lcb, lpre, c);
+        }
+    }
+}
+
+/// Flattens a skeleton into one node array (root at 0, children pairs adjacent).
+fn assemble(sk: Skeleton, prims: usize) -> Vec<Node> {
+    let mut out = Vec::with_capacity(prims / 2 + 8);
+    out.push(Node::default());
+    place(sk, 0, &mut out);
+    out
+}
+
+fn place(sk: Skeleton, at: usize, out: &mut Vec<Node>) {
+    match sk {
+        Skeleton::Inner {
+            bounds,
+            axis,
+            children,
+        } => {
+            let c = out.len();
+            out[at].set_aabb(&bounds);
+            out[at].first = c as u32;
+            out[at].meta = INNER | axis;
+            out.push(Node::default());
+            out.push(Node::default());
+            let (l, r) = *children;
+            place(l, c, out);
+            place(r, c + 1, out);
+        }
+        Skeleton::Local(v) => {
+            // Local index i >= 1 goes to base + i - 1; the local root to `at`.
+            let base = out.len();
+            let fix = |mut n: Node| {
+                if !n.is_leaf() {
+                    n.first = (base + n.first as usize - 1) as u32;
+                }
+                n
+            };
+            out[at] = fix(v[0]);
+            out.extend(v[1..].iter().map(|&n| fix(n)));
+        }
+    }
+}
+
+impl Bvh {
+    /// Binned SAH build with default options (32 bins, ≤ 4 primitives per leaf), parallel over
+    /// subtrees on the current rayon pool. Panics beyond 2³⁰ primitives.
+    pub fn build(g: &Geometry) -> Bvh {
+        Bvh::build_with(g, &BuildOptions::default())
+    }
+
+    /// Binned SAH build (§4.1 step 4, binned as in Wald 2007 instead of the paper's sweep).
+    pub fn build_with(g: &Geometry, opt: &BuildOptions) -> Bvh {
+        let start = Instant::now();
+        let nb = opt.bins.clamp(2, MAX_BINS);
+        let (mut refs, bounds, cb) = prim_refs(g);
+        let n = refs.len();
+        let nodes = if n == 0 {
+            vec![Node::default()]
+        } else {
+            let sk = build_skeleton(&mut refs, 0, bounds, cb, nb, None);
+            assemble(sk, n)
+        };
+        let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();
+        Bvh::finish(g, nodes, order, Builder::Binned, start)
+    }
+
+    /// The paper's builder (§4.1): primitives presorted along x, y and z; each node sweeps all
+    /// three sorted lists and takes the split of least SAH cost. Exact but sequential and
+    /// slow (O(n log n) per level): meant as the quality reference on ≤ 100K primitives.
+    pub fn build_full_sweep(g: &Geometry) -> Bvh {
+        let start = Instant::now();
+        let (refs, _, _) = prim_refs(g);
+        let n = refs.len();
+        if n == 0 {
+            return Bvh::finish(
+                g,
+                vec![Node::default()],
+                Vec::new(),
+                Builder::FullSweep,
+                start,
+            );
+        }
+        let sorted = |k: usize| {
+            let mut v: Vec<u32> = (0..n as u32).collect();
+            v.par_sort_unstable_by(|&a, &b| {
+                refs[a as usize]
+                    .centroid2(k)
+                    .total_cmp(&refs[b as usize].centroid2(k))
+                    .then(a.cmp(&b))
+            });
+            v
+        };
+        let (mut lx, mut ly, mut lz) = (sorted(0), sorted(1), sorted(2));
+        let mut st = Sweep {
+            refs: &refs,
+            nodes: vec![Node::default()],
+            order: Vec::with_capacity(n),
+            left: vec![false; n],
+            tmp: Vec::with_capacity(n),
+            rcost: vec![0.0; n],
+        };
+        st.build([&mut lx, &mut ly, &mut lz], 0);
+        let Sweep { nodes, order, .. } = st;
+        Bvh::finish(g, nodes, order, Builder::FullSweep, start)
+    }
+}
+
+struct Sweep<'r> {
+    refs: &'r [PrimRef],
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+    left: Vec<bool>,
+    tmp: Vec<u32>,
+    rcost: Vec<f32>,
+}
+
+impl Sweep<'_> {
+    fn build(&mut self, lists: [&mut [u32]; 3], at: usize) {
+        let n = lists[0].len();
+        let bounds = lists[0]
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(self.refs[i as usize].aabb()));
+        self.nodes[at].set_aabb(&bounds);
+        if n <= LEAF_MAX {
+            self.nodes[at].first = self.order.len() as u32;
+            self.nodes[at].meta = n as u32;
+            self.order.extend_from_slice(lists[0]);
+            return;
+        }
+        // Sweep every axis: cost of putting the first i primitives left.
+        let mut best = (f32::INFINITY, 0usize, n / 2);
+        for (k, list) in lists.iter().enumerate() {
+            let mut acc = Aabb::EMPTY;
+            for i in (1..n).rev() {
+                acc = acc.union(self.refs[list[i] as usize].aabb());
+                self.rcost[i] = acc.area() * (n - i) as f32;
+            }
+            let mut acc = Aabb::EMPTY;
+            for i in 1..n {
+                acc = acc.union(self.refs[list[i - 1] as usize].aabb());
+                let cost = acc.area() * i as f32 + self.rcost[i];
+                if cost < best.0 {
+                    best = (cost, k, i);
+                }
+            }
+        }
+        let (_, k, nl) = best;
+        for &id in lists[k][..nl].iter() {
+            self.left[id as usize] = true;
+        }
+        for &id in lists[k][nl..].iter() {
+            self.left[id as usize] = false;
+        }
+        let [a, b, c] = lists;
+        let mut parts = [a, b, c];
+        for (kk, list) in parts.iter_mut().enumerate() {
+            if kk == k {
+                continue;
+            }
+            // Stable partition by the left flags.
+            self.tmp.clear();
+            let mut w = 0;
+            for r in 0..n {
+                let id = list[r];
+                if self.left[id as usize] {
+                    list[w] = id;
+                    w += 1;
+                } else {
+                    self.tmp.push(id);
+                }
+            }
+            list[w..].copy_from_slice(&self.tmp);
+        }
+        let child = self.nodes.len();
+        self.nodes[at].first = child as u32;
+        self.nodes[at].meta = INNER | k as u32;
+        self.nodes.push(Node::default());
+        self.nodes.push(Node::default());
+        let [a, b, c] = parts;
+        let (al, ar) = a.split_at_mut(nl);
+        let (bl, br) = b.split_at_mut(nl);
+        let (cl, cr) = c.split_at_mut(nl);
+        self.build([al, bl, cl], child);
+        self.build([ar, br, cr], child + 1);
+    }
+}

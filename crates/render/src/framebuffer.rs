@@ -1,0 +1,83 @@
+//! RGBA8 framebuffer and PNG output.
+
+use std::path::Path;
+
+/// Errors of image output.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// Writing the PNG failed.
+    #[error("writing {path}: {source}")]
+    Png {
+        /// The file.
+        path: String,
+        /// Why.
+        source: image::ImageError,
+    },
+    /// The frame is too large for the PNG encoder or for memory.
+    #[error("framebuffer {0}x{1} is too large")]
+    TooLarge(u32, u32),
+}
+
+/// Row-major RGBA8 pixels, one packed `u32` each (`r | g << 8 | b << 16 | a << 24`, so the
+/// bytes in memory are R, G, B, A), top row first. One flat allocation: 16384² is 1 GiB.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Framebuffer {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height` packed pixels.
+    pub pixels: Vec<u32>,
+}
+
+impl Framebuffer {
+    /// A frame filled with `color` (packed RGBA8).
+    pub fn new(width: u32, height: u32, color: u32) -> Result<Framebuffer, RenderError> {
+        let n = (width as usize)
+            .checked_mul(height as usize)
+            .filter(|&n| n <= isize::MAX as usize / 4)
+            .ok_or(RenderError::TooLarge(width, height))?;
+        let mut pixels = Vec::new();
+        pixels
+            .try_reserve_exact(n)
+            .map_err(|_| RenderError::TooLarge(width, height))?;
+        pixels.resize(n, color);
+        Ok(Framebuffer {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// RGBA bytes of pixel (x, y).
+    pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
+        self.pixels[y as usize * self.width as usize + x as usize].to_le_bytes()
+    }
+
+    /// The pixels as R, G, B, A bytes (no copy on little-endian machines).
+    pub fn as_bytes(&self) -> std::borrow::Cow<'_, [u8]> {
+        if cfg!(target_endian = "little") {
+            std::borrow::Cow::Borrowed(bytemuck::cast_slice(&self.pixels))
+        } else {
+            std::borrow::Cow::Owned(self.pixels.iter().flat_map(|p| p.to_le_bytes()).collect())
+        }
+    }
+
+    /// Writes an 8-bit RGBA PNG.
+    pub fn save_png(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
+        let path = path.as_ref();
+        let err = |source| RenderError::Png {
+            path: path.display().to_string(),
+            source,
+        };
+        image::save_buffer_with_format(
+            path,
+            &self.as_bytes(),
+            self.width,
+            self.height,
+            image::ExtendedColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(err)
+    }
+}

@@ -1,0 +1,197 @@
+//! Scene assembly: styles, radii, colours, BVH.
+
+use bvh::{Bvh, Geometry, Prim};
+use rayon::prelude::*;
+
+use crate::colormap::Colormap;
+
+/// How the molecule is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    /// Balls and sticks (stick ends hidden in the balls).
+    BallAndStick,
+    /// Sticks only, with round caps (licorice).
+    Licorice,
+    /// Balls only (space-filling with van der Waals radii).
+    Spheres,
+}
+
+/// How atoms are coloured.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Coloring {
+    /// The per-atom colours passed to [`Scene::new`] (e.g. CPK by element).
+    PerAtom,
+    /// A per-atom scalar mapped through a colormap; `range` = values mapped to 0 and 1
+    /// (`None`: the finite min and max of the values).
+    Scalar {
+        /// One value per atom.
+        values: Vec<f32>,
+        /// Colormap.
+        colormap: Colormap,
+        /// Value range mapped onto the colormap.
+        range: Option<(f32, f32)>,
+    },
+}
+
+/// Geometry options (they decide what the BVH is built over).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneOptions {
+    /// Ball radius = per-atom radius × this (e.g. 0.5 with covalent radii, 1.0 with vdW).
+    pub radius_scale: f32,
+    /// Stick radius (Å).
+    pub stick_radius: f32,
+    /// Drawing style.
+    pub style: Style,
+    /// Colouring.
+    pub coloring: Coloring,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        SceneOptions {
+            radius_scale: 0.5,
+            stick_radius: 0.15,
+            style: Style::BallAndStick,
+            coloring: Coloring::PerAtom,
+        }
+    }
+}
+
+/// A renderable ball-and-stick scene: geometry, BVH, per-slot colours, bounding sphere.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Balls and sticks.
+    pub geometry: Geometry,
+    /// The BVH over them (its `stats` hold build time, node count, SAH cost, bytes).
+    pub bvh: Bvh,
+    /// Colour (packed RGBA8 as i32) of each BVH slot: the ball's atom, or a stick's first atom.
+    pub slot_color_a: Vec<i32>,
+    /// Colour of each slot's second half (sticks: atom b; balls: as `slot_color_a`).
+    pub slot_color_b: Vec<i32>,
+    /// Centre of the bounding sphere (Å).
+    pub center: [f32; 3],
+    /// Radius of the bounding sphere (Å), including ball radii.
+    pub radius: f32,
+}
+
+impl Scene {
+    /// Builds a scene from atom positions (Å), per-atom base radius (Å, scaled by
+    /// `opt.radius_scale`), per-atom colours (packed RGBA8, see [`crate::rgba`]) and bonds.
+    /// Bonds with an atom index out of range are ignored. `colors` may be empty (grey).
+    /// Panics if `x`, `y`, `z` and `radius` differ in length.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        x: &[f32],
+        y: &[f32],
+        z: &[f32],
+        radius: &[f32],
+        colors: &[u32],
+        bonds: &[[u32; 2]],
+        opt: &SceneOptions,
+    ) -> Scene {
+        let n = x.len();
+        let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
+        let colors: Vec<u32> = match &opt.coloring {
+            Coloring::PerAtom => {
+                if colors.len() == n {
+                    colors.to_vec()
+                } else {
+                    vec![crate::rgba(200, 200, 200, 255); n]
+                }
+            }
+            Coloring::Scalar {
+                values,
+                colormap,
+                range,
+            } => {
+                let (lo, hi) = range.unwrap_or_else(|| {
+                    values
+                        .iter()
+                        .filter(|v| v.is_finite())
+                        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| {
+                            (a.min(v), b.max(v))
+                        })
+                });
+                let span = if hi > lo { hi - lo } else { 1.0 };
+                (0..n)
+                    .map(|i| {
+                        let v = values.get(i).copied().unwrap_or(f32::NAN);
+                        let [r, g, b] = colormap.map((v - lo) / span);
+                        crate::rgba(r, g, b, 255)
+                    })
+                    .collect()
+            }
+        };
+        let bonds: &[[u32; 2]] = if opt.style == Style::Spheres {
+            &[]
+        } else {
+            bonds
+        };
+        let mut g = Geometry::from_atoms(x, y, z, &radii, &colors, bonds, opt.stick_radius);
+        g.show_balls = opt.style != Style::Licorice;
+        g.capped = opt.style == Style::Licorice;
+        Scene::from_geometry(g)
+    }
+
+    /// Builds the BVH and colour tables for ready-made geometry (colours from
+    /// `g.balls.color`, grey where missing).
+    pub fn from_geometry(g: Geometry) -> Scene {
+        let bvh = Bvh::build(&g);
+        let color = |atom: u32| -> i32 {
+            g.balls
+                .color
+                .get(atom as usize)
+                .copied()
+                .unwrap_or(crate::rgba(200, 200, 200, 255)) as i32
+        };
+        let (slot_color_a, slot_color_b): (Vec<i32>, Vec<i32>) = bvh
+            .prim_ids
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&id| match g.prim(id) {
+                Prim::Ball(i) => (color(i), color(i)),
+                Prim::Stick(j) => (color(g.sticks.a[j as usize]), color(g.sticks.b[j as usize])),
+            })
+            .unzip();
+        // Bounding sphere: centre of the box, radius to the farthest ball surface (tighter than
+        // the box's half diagonal, so the far view is filled as well as it can be).
+        let b = bvh.bounds;
+        let (center, radius) = if b.is_empty() {
+            ([0.0; 3], 1.0)
+        } else {
+            let c = b.center();
+            let extra = g.sticks.radius.max(0.0);
+            let r = (0..g.balls.len())
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|i| {
+                    let d = [
+                        (g.balls.x[i] - c[0]) as f64,
+                        (g.balls.y[i] - c[1]) as f64,
+                        (g.balls.z[i] - c[2]) as f64,
+                    ];
+                    let rb = if g.show_balls {
+                        g.balls.radius[i].max(extra)
+                    } else {
+                        extra
+                    };
+                    let v = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() + rb as f64;
+                    if v.is_finite() {
+                        v
+                    } else {
+                        0.0
+                    }
+                })
+                .reduce(|| 0.0, f64::max) as f32;
+            (c, r.max(1e-3))
+        };
+        Scene {
+            geometry: g,
+            bvh,
+            slot_color_a,
+            slot_color_b,
+            center,
+            radius,
+        }
+    }
+}

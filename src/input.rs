@@ -1,0 +1,205 @@
+//! Loading the input shared by `info`, `render` and `bench`: a molecule file or a built-in
+//! scene, one frame of it, and its bonds, with a spinner and timings.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use molecule::bonds::{build_bonds, BondOptions};
+use molecule::read::{open, Format, ReadOptions};
+use molecule::scenes::{generate, SceneName};
+use molecule::Molecule;
+
+/// Where bonds come from.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BondSource {
+    /// Geometric rule (uniform-grid neighbour search).
+    Auto,
+    /// Bonds listed in the file (LAMMPS data `Bonds`, PDB `CONECT`); error if there are none.
+    File,
+    /// No bonds.
+    None,
+}
+
+/// Where the atoms come from and how they are bonded.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Molecule file (xyz, pdb, lammps dump/data, gro; optionally .gz).
+    #[arg(conflicts_with = "scene")]
+    pub file: Option<PathBuf>,
+    /// Built-in scene instead of a file: nanobowl, ns90k, ns740k, sio2, anp3.
+    #[arg(long)]
+    pub scene: Option<SceneName>,
+    /// Scene size in atoms (default: the paper's count).
+    #[arg(long, requires = "scene")]
+    pub atoms: Option<usize>,
+    /// Scene random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// File format (default: from the extension or content).
+    #[arg(long)]
+    pub format: Option<Format>,
+    /// LAMMPS type → element mapping, e.g. `1=Al,2=O`.
+    #[arg(long)]
+    pub types: Option<String>,
+    /// LAMMPS data atom style if the file does not say (atomic, charge, molecular, full).
+    #[arg(long)]
+    pub atom_style: Option<String>,
+    /// Frame to describe (0-based).
+    #[arg(long, default_value_t = 0)]
+    pub frame: usize,
+    /// Bond source.
+    #[arg(long, value_enum, default_value_t = BondSource::Auto)]
+    pub bonds: BondSource,
+    /// Bond factor f in d < f·(rcov_i + rcov_j).
+    #[arg(long, default_value_t = 1.15)]
+    pub bond_factor: f32,
+    /// One bond cutoff (Å) for all pairs.
+    #[arg(long)]
+    pub bond_cutoff: Option<f32>,
+    /// Per-pair cutoffs (Å), e.g. `Al-O=2.2,Si-O=1.9`.
+    #[arg(long)]
+    pub pair_cutoffs: Option<String>,
+    /// Periodic boundaries (minimum image) for bonds, using the file's cell.
+    #[arg(long)]
+    pub pbc: bool,
+}
+
+/// A spinner on stderr that only appears after half a second and never when stderr is not a
+/// terminal.
+pub fn spinner(msg: &str) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+        pb.set_style(style);
+    }
+    pb.set_message(msg.to_string());
+    pb.enable_steady_tick(Duration::from_millis(500));
+    pb
+}
+
+/// A loaded frame with its bonds and what it took.
+pub struct Loaded {
+    /// Human description of the source (path or scene and seed).
+    pub source: String,
+    /// The frame.
+    pub molecule: Molecule,
+    /// Frames in the input (1 for a scene).
+    pub frames: usize,
+    /// Reader warnings (unknown elements, …).
+    pub warnings: Vec<String>,
+    /// Format of the file, if one was read.
+    pub format: Option<Format>,
+    /// File size in bytes, if one was read.
+    pub file_bytes: Option<u64>,
+    /// Bonds, pairs i<j sorted.
+    pub bonds: Vec<[u32; 2]>,
+    /// Time to read or generate the frame (s).
+    pub load_s: f64,
+    /// Time to build the bonds (s).
+    pub bond_s: f64,
+}
+
+impl InputArgs {
+    /// Bond options from the flags.
+    pub fn bond_options(&self) -> anyhow::Result<BondOptions> {
+        Ok(BondOptions {
+            factor: self.bond_factor,
+            global_cutoff: self.bond_cutoff,
+            pair_cutoffs: match &self.pair_cutoffs {
+                Some(s) => BondOptions::parse_pair_cutoffs(s).map_err(anyhow::Error::msg)?,
+                None => Vec::new(),
+            },
+            pbc: self.pbc,
+            ..BondOptions::default()
+        })
+    }
+
+    /// Reads (or generates) the frame and builds its bonds; `count_frames` also scans the
+    /// whole file for the number of frames.
+    pub fn load(&self, count_frames: bool) -> anyhow::Result<Loaded> {
+        let bond_opts = self.bond_options()?;
+        let t0 = Instant::now();
+        let pb = spinner("loading");
+        let (source, m, frames, warnings, format, file_bytes) = if let Some(scene) = self.scene {
+            if self.frame != 0 {
+                bail!(
+                    "--frame {}: built-in scenes have a single frame",
+                    self.frame
+                );
+            }
+            pb.set_message(format!("generating {scene}"));
+            let m = generate(scene, self.atoms, self.seed);
+            (
+                format!("scene {scene} (seed {})", self.seed),
+                m,
+                1,
+                Vec::new(),
+                None,
+                None,
+            )
+        } else {
+            let path = self
+                .file
+                .clone()
+                .context("no input: give a FILE or --scene NAME")?;
+            let opts = ReadOptions {
+                format: self.format,
+                types: match &self.types {
+                    Some(s) => ReadOptions::parse_types(s).map_err(anyhow::Error::msg)?,
+                    None => Vec::new(),
+                },
+                atom_style: self.atom_style.clone(),
+            };
+            let bytes = std::fs::metadata(&path).map(|m| m.len()).ok();
+            pb.set_message(format!("reading {}", path.display()));
+            let mut t = open(&path, &opts)?;
+            let m = t.read_frame(self.frame)?;
+            let frames = if count_frames {
+                pb.set_message("counting frames".to_string());
+                t.count_frames()?
+            } else {
+                0
+            };
+            let w = t.warnings().to_vec();
+            (
+                path.display().to_string(),
+                m,
+                frames,
+                w,
+                Some(t.format()),
+                bytes,
+            )
+        };
+        let load_s = t0.elapsed().as_secs_f64();
+        for w in &warnings {
+            pb.suspend(|| eprintln!("warning: {w}"));
+        }
+        pb.set_message(format!("building bonds for {} atoms", m.len()));
+        let t1 = Instant::now();
+        let bonds = match self.bonds {
+            BondSource::Auto => build_bonds(&m, &bond_opts),
+            BondSource::File => match &m.file_bonds {
+                Some(b) => b.clone(),
+                None => {
+                    bail!("--bonds file: the input lists no bonds (LAMMPS data Bonds / PDB CONECT)")
+                }
+            },
+            BondSource::None => Vec::new(),
+        };
+        let bond_s = t1.elapsed().as_secs_f64();
+        pb.finish_and_clear();
+        Ok(Loaded {
+            source,
+            molecule: m,
+            frames,
+            warnings,
+            format,
+            file_bytes,
+            bonds,
+            load_s,
+            bond_s,
+        })
+    }
+}

@@ -78,8 +78,18 @@ fn main() {
         t.elapsed().as_secs_f64()
     );
     let t = Instant::now();
+    // VOLUME_OPACITY=k scales the preset's opacity; VOLUME_LIT=1 adds headlight shading.
+    let k: f32 = std::env::var("VOLUME_OPACITY")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1.0);
+    let lighting = if std::env::var("VOLUME_LIT").is_ok() {
+        Lighting::Headlight
+    } else {
+        Lighting::Unlit
+    };
     let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::CoolWarm),
+        &TransferFunction::preset(Preset::CoolWarm).scale_opacity(k),
         0.0,
         v.max_value,
         0.5,
@@ -99,6 +109,7 @@ fn main() {
                 let opts = MarchOptions {
                     macrocells,
                     preintegrated,
+                    lighting,
                     ..Default::default()
                 };
                 let sc = VolumeScene::new(&v, &mc, &ctf, opts);
@@ -130,6 +141,29 @@ fn main() {
                     }
                 }
                 let dt = best;
+                if let Ok(dir) = std::env::var("VOLUME_PNG_DIR") {
+                    // Premultiplied RGBA over a dark background.
+                    let bg = [0.05f32, 0.05, 0.08];
+                    let px: Vec<u8> = out
+                        .iter()
+                        .flat_map(|c| {
+                            (0..3).map(move |k| {
+                                ((c[k] + (1.0 - c[3]) * bg[k]).clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+                            })
+                        })
+                        .collect();
+                    let name = format!(
+                        "{dir}/ns_{view}_{isa}_cells{macrocells}_preint{preintegrated}.png"
+                    );
+                    image::save_buffer(
+                        &name,
+                        &px,
+                        size as u32,
+                        size as u32,
+                        image::ColorType::Rgb8,
+                    )
+                    .unwrap();
+                }
                 let cover = out.iter().map(|c| c[3] as f64).sum::<f64>() / out.len() as f64;
                 println!(
                     "march {view:>5} {isa:>7} cells {macrocells:<5} preint {preintegrated:<5}: {:6.2} Mrays/s wall (best of 3, {:.0} ms), {:5.2} Mrays/CPU-s, mean α {cover:.3}",

@@ -1,5 +1,6 @@
 //! The RBF density grid (paper §3.1): Φ(x) = Σᵢ √rᵢ·exp(−d²/rᵢ²) for d < √2·rᵢ, sampled at
 //! the lattice points of a regular grid, built in parallel over z-slabs with SIMD along x.
+//! Values are f32 sums (atoms in a fixed order), optionally quantised to u8.
 //!
 //! ## Sampling convention
 //! Values live at **lattice points** (voxel corners): sample `(i, j, k)` is Φ at
@@ -269,7 +270,7 @@ fn check_atoms(x: &[f32], y: &[f32], z: &[f32], r: &[f32]) -> Result<(), VolumeE
 const SLAB: usize = 4;
 
 /// Bytes the build will hold at its peak for `grid` in `format`: the voxels (+4 bytes of
-/// padding), the macrocell grid, and for u8 one f32 slab per worker thread.
+/// padding), the macrocell grid, and one f32 block (4 planes × 32 rows) per worker thread.
 pub fn estimate_bytes(grid: &Grid, format: VolumeFormat) -> u64 {
     let voxels = grid
         .voxel_count()
@@ -282,11 +283,8 @@ pub fn estimate_bytes(grid: &Grid, format: VolumeFormat) -> u64 {
                 .max(1),
         )
     });
-    let slab = (SLAB * grid.dims[0] * grid.dims[1]) as u64 * 4;
-    let scratch = match format {
-        VolumeFormat::U8 => slab * rayon::current_num_threads() as u64,
-        VolumeFormat::F32 => 0,
-    };
+    let block = (SLAB * YBLOCK * grid.dims[0]) as u64 * 4;
+    let scratch = block * rayon::current_num_threads() as u64;
     voxels
         .saturating_add(cells.saturating_mul(8))
         .saturating_add(scratch)
@@ -303,10 +301,13 @@ pub fn default_budget_bytes() -> Option<u64> {
 /// Builds the density volume of the atoms (positions `x, y, z` and covalent radii `r`, Å)
 /// on [`Grid::for_atoms`] at `params.voxels_per_angstrom`, using backend `isa`.
 ///
+/// Work: atoms are binned by z-slab (4 lattice planes) and sorted by (y-band, x); rayon runs
+/// one task per slab, which computes the slab in y-blocks of 32 rows (an f32 scratch that
+/// stays in L2) with SIMD along x, then copies (f32) or quantises (u8) the block out.
+///
 /// Deterministic: every voxel sums its atoms in a fixed order (by y-band, x, index) whatever
-/// the thread count, so
-/// the result depends only on the inputs and the ISA (AVX2/AVX-512 fuse multiply-adds in
-/// `exp`, which changes the last bits).
+/// the thread count, so the result depends only on the inputs and the ISA (AVX2/AVX-512 fuse
+/// multiply-adds in `exp`, which changes the last bits).
 ///
 /// Errors: inconsistent or non-finite input, or [`VolumeError::TooLarge`] (with a suggested
 /// resolution) when [`estimate_bytes`] exceeds the budget or the voxel count exceeds what
@@ -350,6 +351,17 @@ pub fn build_density(
     let bins = bin_atoms_by_slab(&grid, x, y, z, r);
     let plane = grid.dims[0] * grid.dims[1];
     let atoms = Atoms { x, y, z, r };
+    let rmax = r.iter().copied().fold(0.0f32, f32::max);
+    let reach_vox = core::f32::consts::SQRT_2 * rmax / grid.spacing + 1.0;
+    let ctx = SlabCtx {
+        isa,
+        grid: &grid,
+        atoms: &atoms,
+        bins: &bins,
+        reach_vox,
+    };
+    let [nx, ny, _] = grid.dims;
+    let fmax = |m: f32, b: &[f32]| m.max(isa.dispatch(BlockMax(b)));
 
     match params.format {
         VolumeFormat::F32 => {
@@ -357,9 +369,14 @@ pub fn build_density(
             let max_value = data
                 .par_chunks_mut(SLAB * plane)
                 .enumerate()
-                .map(|(slab, out)| {
-                    splat_slab(isa, &grid, &atoms, &bins, slab, out);
-                    out.iter().copied().fold(0.0f32, f32::max)
+                .map_init(Vec::new, |buf: &mut Vec<f32>, (slab, out)| {
+                    let mut m = 0.0f32;
+                    ctx.splat(slab, buf, |p, y0, block| {
+                        let o = (p * ny + y0) * nx;
+                        out[o..o + block.len()].copy_from_slice(block);
+                        m = fmax(m, block);
+                    });
+                    m
                 })
                 .reduce(|| 0.0, f32::max);
             Ok(Volume {
@@ -374,11 +391,9 @@ pub fn build_density(
             let max_value = (0..nslabs)
                 .into_par_iter()
                 .map_init(Vec::new, |buf: &mut Vec<f32>, slab| {
-                    let len = slab_len(&grid, slab);
-                    buf.clear();
-                    buf.resize(len, 0.0);
-                    splat_slab(isa, &grid, &atoms, &bins, slab, buf);
-                    buf.iter().copied().fold(0.0f32, f32::max)
+                    let mut m = 0.0f32;
+                    ctx.splat(slab, buf, |_, _, block| m = fmax(m, block));
+                    m
                 })
                 .reduce(|| 0.0, f32::max);
             let scale = if max_value > 0.0 {
@@ -394,12 +409,14 @@ pub fn build_density(
                 .par_chunks_mut(SLAB * plane)
                 .enumerate()
                 .for_each_init(Vec::new, |buf: &mut Vec<f32>, (slab, out)| {
-                    buf.clear();
-                    buf.resize(out.len(), 0.0);
-                    splat_slab(isa, &grid, &atoms, &bins, slab, buf);
-                    for (q, v) in out.iter_mut().zip(buf.iter()) {
-                        *q = (v * inv + 0.5).min(255.0) as u8;
-                    }
+                    ctx.splat(slab, buf, |p, y0, block| {
+                        let o = (p * ny + y0) * nx;
+                        isa.dispatch(Quantise {
+                            values: block,
+                            inv_scale: inv,
+                            out: &mut out[o..o + block.len()],
+                        });
+                    });
                 });
             Ok(Volume {
                 grid,
@@ -410,10 +427,107 @@ pub fn build_density(
     }
 }
 
-fn slab_len(grid: &Grid, slab: usize) -> usize {
-    let z0 = slab * SLAB;
-    let planes = SLAB.min(grid.dims[2] - z0);
-    planes * grid.dims[0] * grid.dims[1]
+/// Largest value of a block (values are ≥ 0; 0 for an empty block).
+struct BlockMax<'a>(&'a [f32]);
+
+impl Kernel for BlockMax<'_> {
+    type Output = f32;
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) -> f32 {
+        let mut m = s.splat(0.0);
+        for c in self.0.chunks(S::LANES) {
+            m = s.max(s.load_partial(c, 0.0), m);
+        }
+        s.reduce_max(m)
+    }
+}
+
+/// `out = min(round(values · inv_scale), 255)` for non-negative values (u8 quantisation).
+struct Quantise<'a, 'b> {
+    values: &'a [f32],
+    inv_scale: f32,
+    out: &'b mut [u8],
+}
+
+impl Kernel for Quantise<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) {
+        let mut q = [0i32; spmd::MAX_LANES];
+        let (k, half, top) = (s.splat(self.inv_scale), s.splat(0.5), s.splat(255.0));
+        for (c, o) in self
+            .values
+            .chunks(S::LANES)
+            .zip(self.out.chunks_mut(S::LANES))
+        {
+            let v = s.min(s.load_partial(c, 0.0) * k + half, top);
+            s.store_i(s.to_i32(v), &mut q);
+            for (dst, src) in o.iter_mut().zip(q) {
+                *dst = src as u8;
+            }
+        }
+    }
+}
+
+/// Lattice rows per y-block: a block's f32 scratch (4 planes × 32 rows × nx) stays in L2.
+const YBLOCK: usize = 32;
+
+/// Band of an atom's y coordinate (the primary sort key of the slab lists).
+#[inline]
+fn band_key(grid: &Grid, y: f32) -> u32 {
+    ((y - grid.origin[1]) * (1.0 / grid.spacing) / BAND) as u32
+}
+
+/// What every slab task shares.
+struct SlabCtx<'a> {
+    isa: Isa,
+    grid: &'a Grid,
+    atoms: &'a Atoms<'a>,
+    bins: &'a [Vec<u32>],
+    /// Largest support radius in voxels, plus one.
+    reach_vox: f32,
+}
+
+impl SlabCtx<'_> {
+    /// Computes z-slab `slab` one y-block at a time in `scratch`, then hands every plane's
+    /// rows of the block to `emit(plane, first_row, values)` (`rows × nx` values, x fastest).
+    fn splat(
+        &self,
+        slab: usize,
+        scratch: &mut Vec<f32>,
+        mut emit: impl FnMut(usize, usize, &[f32]),
+    ) {
+        let [nx, ny, nz] = self.grid.dims;
+        let z0 = slab * SLAB;
+        let planes = SLAB.min(nz - z0);
+        let list = &self.bins[slab];
+        let key = |i: &u32| band_key(self.grid, self.atoms.y[*i as usize]);
+        let mut y0 = 0;
+        while y0 < ny {
+            let rows = YBLOCK.min(ny - y0);
+            let len = planes * rows * nx;
+            scratch.clear();
+            scratch.resize(len, 0.0);
+            // Atoms whose centre band can reach rows y0..y0+rows.
+            let blo = ((y0 as f32 - self.reach_vox).max(0.0) / BAND) as u32;
+            let bhi = (((y0 + rows) as f32 + self.reach_vox) / BAND) as u32;
+            let a = list.partition_point(|i| key(i) < blo);
+            let b = list.partition_point(|i| key(i) <= bhi);
+            self.isa.dispatch(SplatSlab {
+                grid: self.grid,
+                atoms: self.atoms,
+                list: &list[a..b.max(a)],
+                z0,
+                y0,
+                rows,
+                out: &mut scratch[..len],
+            });
+            for p in 0..planes {
+                emit(p, y0, &scratch[p * rows * nx..(p + 1) * rows * nx]);
+            }
+            y0 += rows;
+        }
+    }
 }
 
 struct Atoms<'a> {
@@ -456,7 +570,7 @@ fn bin_atoms_by_slab(grid: &Grid, x: &[f32], y: &[f32], z: &[f32], r: &[f32]) ->
     bins.par_iter_mut().for_each(|b| {
         b.sort_unstable_by_key(|&i| {
             let i = i as usize;
-            let band = ((y[i] - grid.origin[1]) * inv / BAND) as u32;
+            let band = band_key(grid, y[i]);
             let col = ((x[i] - grid.origin[0]) * inv) as u32;
             (band, col, i as u32)
         })
@@ -464,29 +578,15 @@ fn bin_atoms_by_slab(grid: &Grid, x: &[f32], y: &[f32], z: &[f32], r: &[f32]) ->
     bins
 }
 
-/// Adds every binned atom's Gaussian to the f32 slab `out` (planes `slab·SLAB ..`).
-fn splat_slab(
-    isa: Isa,
-    grid: &Grid,
-    atoms: &Atoms,
-    bins: &[Vec<u32>],
-    slab: usize,
-    out: &mut [f32],
-) {
-    isa.dispatch(SplatSlab {
-        grid,
-        atoms,
-        list: &bins[slab],
-        z0: slab * SLAB,
-        out,
-    });
-}
-
+/// Adds the Gaussians of `list` to a block of the slab starting at plane `z0`, rows
+/// `y0 .. y0 + rows`, stored in `out` (planes × rows × nx, x fastest).
 struct SplatSlab<'a> {
     grid: &'a Grid,
     atoms: &'a Atoms<'a>,
     list: &'a [u32],
     z0: usize,
+    y0: usize,
+    rows: usize,
     out: &'a mut [f32],
 }
 
@@ -498,7 +598,9 @@ impl Kernel for SplatSlab<'_> {
     fn run<S: Simd>(self, s: S) {
         let g = self.grid;
         let (nx, ny) = (g.dims[0], g.dims[1]);
-        let planes = self.out.len() / (nx * ny);
+        let _ = ny;
+        let planes = self.out.len() / (nx * self.rows);
+        let ylast = self.y0 + self.rows - 1;
         let h = g.spacing;
         let lanes_f = s.to_f32(s.lane_index());
         for &ai in self.list {
@@ -531,6 +633,7 @@ impl Kernel for SplatSlab<'_> {
                 let Some((ylo, yhi)) = lattice_range(ay, rz2.sqrt(), g.origin[1], h, ny) else {
                     continue;
                 };
+                let (ylo, yhi) = (ylo.max(self.y0), yhi.min(ylast));
                 for jy in ylo..=yhi {
                     let dy = g.origin[1] + jy as f32 * h - ay;
                     let dyz2 = dy * dy + dz * dz;
@@ -541,7 +644,7 @@ impl Kernel for SplatSlab<'_> {
                     let Some((xlo, xhi)) = lattice_range(ax, rx2.sqrt(), g.origin[0], h, nx) else {
                         continue;
                     };
-                    let row = ((kz - self.z0) * ny + jy) * nx;
+                    let row = ((kz - self.z0) * self.rows + jy - self.y0) * nx;
                     let dyz2v = s.splat(dyz2);
                     let mut ix = xlo;
                     while ix <= xhi {

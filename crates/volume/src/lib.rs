@@ -21,7 +21,8 @@
 //! the step is 0.5 voxel; transfer-function opacity is per voxel of path.
 //!
 //! Transfer functions: [`Preset`]s (`coolwarm`, `viridis`, `grayscale`) or a text file of
-//! control points `value r g b a` — see the [`tf`] module for the format.
+//! control points `value r g b a` — see the [`tf`] module for the format and
+//! `crates/volume/tf/density-ramp.tf` for an example file.
 //!
 //! ## Use from a renderer
 //! ```

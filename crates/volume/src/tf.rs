@@ -318,16 +318,27 @@ impl ClassifiedTf {
             }
             post[i * 4 + 3] = a as f32;
         }
+        // The classification sampled at 1/16 bin, with extinction instead of opacity, so the
+        // 65536 integrals below need no logarithm (as `preintegrate`, in f32; ~3× faster).
+        let fine: Vec<[f32; 4]> = (0..=255 * FINE)
+            .map(|i| {
+                let e = tf.eval(i as f64 / FINE as f64);
+                [
+                    e[0] as f32,
+                    e[1] as f32,
+                    e[2] as f32,
+                    extinction(e[3]) as f32,
+                ]
+            })
+            .collect();
         let mut preint = vec![0.0f32; TF_SIZE * TF_SIZE * 4];
         preint
             .par_chunks_mut(TF_SIZE * 4)
             .enumerate()
             .for_each(|(f, row)| {
                 for b in 0..TF_SIZE {
-                    let v = preintegrate(tf, f as f64, b as f64, d);
-                    for c in 0..4 {
-                        row[b * 4 + c] = v[c] as f32;
-                    }
+                    let v = preintegrate_fine(&fine, f as f32, b as f32, step_voxels);
+                    row[b * 4..b * 4 + 4].copy_from_slice(&v);
                 }
             });
         let mut range_max = vec![0.0f32; TF_SIZE * TF_SIZE];
@@ -354,6 +365,28 @@ impl ClassifiedTf {
     pub fn bin(&self, v: f32) -> usize {
         (((v - self.lo) * self.to_bin).clamp(0.0, 255.0) + 0.5) as usize
     }
+}
+
+/// Sub-samples per bin of the classification table used to pre-integrate.
+const FINE: usize = 16;
+
+/// [`preintegrate`] with the classification looked up in `fine` (`[r, g, b, τ]` every 1/16
+/// bin, nearest), in f32.
+fn preintegrate_fine(fine: &[[f32; 4]], f: f32, b: f32, len: f32) -> [f32; 4] {
+    let n = (2.0 * (b - f).abs()).ceil() as usize + 1;
+    let dl = len / n as f32;
+    let (mut c, mut t) = ([0.0f32; 3], 1.0f32);
+    for k in 0..n {
+        let x = f + (b - f) * (k as f32 + 0.5) / n as f32;
+        let e = fine[(x * FINE as f32 + 0.5) as usize];
+        let a = 1.0 - (-dl * e[3]).exp();
+        let w = t * a;
+        for ch in 0..3 {
+            c[ch] += w * e[ch];
+        }
+        t *= 1.0 - a;
+    }
+    [c[0], c[1], c[2], 1.0 - t]
 }
 
 /// Premultiplied RGBA of a segment of `len` voxels whose bin coordinate goes linearly from

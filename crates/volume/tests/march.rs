@@ -600,3 +600,31 @@ fn degenerate_rays_terminate_with_nothing() {
         }
     }
 }
+
+#[test]
+fn shipped_transfer_function_file_parses() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tf/density-ramp.tf");
+    let tf = TransferFunction::load(&path).unwrap();
+    assert_eq!(tf.table[0][3], 0.0);
+    assert!((tf.table[255][3] - 0.35).abs() < 1e-6);
+    assert!(tf.table.windows(2).all(|w| w[1][3] >= w[0][3]));
+}
+
+#[test]
+fn preintegration_table_matches_double_precision_integral() {
+    let tf = ramp_tf();
+    let c = ClassifiedTf::new(&tf, 0.0, 1.0, 0.5);
+    let mut rng = Rng(17);
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        let (f, b) = (
+            (rng.next_u64() % 256) as usize,
+            (rng.next_u64() % 256) as usize,
+        );
+        let want = preintegrate(&tf, f as f64, b as f64, 0.5);
+        for (ch, w) in want.iter().enumerate() {
+            worst = worst.max((c.preint[(f * 256 + b) * 4 + ch] as f64 - w).abs());
+        }
+    }
+    assert!(worst < 2e-4, "table vs f64 integral: {worst}");
+}

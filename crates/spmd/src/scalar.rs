@@ -17,6 +17,26 @@ fn bounds(idx: i32, len: usize) -> usize {
     }
 }
 
+/// Floor (`up == false`) or ceiling without a libm call (the x86-64 baseline has no
+/// `roundss`, so `f32::floor` is a function call that dominated scalar kernels): truncate
+/// through `i32` where that is exact (|a| < 2²³), fix up by one, keep the sign of zero.
+/// Larger magnitudes, infinities and NaN are already integral and returned as they are.
+#[inline(always)]
+fn round_toward(a: f32, up: bool) -> f32 {
+    if !(a.abs() < 8_388_608.0) {
+        return a;
+    }
+    let t = a as i32 as f32;
+    let r = if !up && t > a {
+        t - 1.0
+    } else if up && t < a {
+        t + 1.0
+    } else {
+        t
+    };
+    r.copysign(a)
+}
+
 impl Simd for Scalar {
     const LANES: usize = 1;
     const ISA: Isa = Isa::Scalar;
@@ -111,11 +131,11 @@ impl Simd for Scalar {
     }
     #[inline(always)]
     fn floor(self, a: f32) -> f32 {
-        a.floor()
+        round_toward(a, false)
     }
     #[inline(always)]
     fn ceil(self, a: f32) -> f32 {
-        a.ceil()
+        round_toward(a, true)
     }
     #[inline(always)]
     fn rcp(self, a: f32) -> f32 {

@@ -5,7 +5,10 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use render::{render_frame_into, Camera, Framebuffer, RenderOptions, View};
+use render::{
+    render_frame_into, render_modal_into, Accum, Camera, Framebuffer, Material, Modality,
+    RenderOptions, SecondaryTraversal, TraceOptions, View,
+};
 use spmd::Isa;
 use volume::{ClassifiedTf, Lighting, MarchOptions, Preset, TransferFunction, VolumeScene};
 
@@ -22,6 +25,8 @@ pub enum Mode {
     /// Ball-and-stick, then the volume in front of it.
     #[value(name = "vol+bs")]
     VolBs,
+    /// Ball-and-stick, path traced (`--material`, `--spp`): progressive f32 accumulation.
+    Path,
 }
 
 impl Mode {
@@ -31,7 +36,38 @@ impl Mode {
             Mode::Bs => "bs",
             Mode::Volume => "volume",
             Mode::VolBs => "vol+bs",
+            Mode::Path => "path",
         }
+    }
+}
+
+/// BRDF of the path tracer (`--material`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialArg {
+    /// Conductor with Schlick Fresnel (F0 = atom colour), blurred by --roughness.
+    Metal,
+    /// Lambertian.
+    Diffuse,
+}
+
+/// Traversal of secondary rays (`--secondary`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SecondaryArg {
+    /// A pixel block's secondary rays as one packet, any-hit early exit.
+    Packet,
+    /// One ray at a time (scalar traversal).
+    Single,
+}
+
+fn parse_dir(s: &str) -> Result<[f32; 3], String> {
+    let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
+    match v.as_slice() {
+        [Some(x), Some(y), Some(z)]
+            if [x, y, z].iter().all(|a| a.is_finite()) && (x * x + y * y + z * z) > 0.0 =>
+        {
+            Ok([*x, *y, *z])
+        }
+        _ => Err(format!("{s:?}: expected a non-zero direction x,y,z")),
     }
 }
 
@@ -81,9 +117,56 @@ pub struct RenderArgs {
     /// points `value r g b a` (value in [0,1] of the density range).
     #[arg(long, default_value = "coolwarm")]
     pub tf: String,
-    /// Volume: gradient lighting by central differences (headlight).
+    /// Volume: gradient lighting by central differences (headlight, or from --light-dir when
+    /// given).
     #[arg(long)]
     pub lit: bool,
+    /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir with hard shadows.
+    #[arg(long)]
+    pub shadows: bool,
+    /// Ball-and-stick (bs, vol+bs): ambient occlusion with N cosine-distributed rays per hit.
+    #[arg(long, value_name = "N")]
+    pub ao: Option<u32>,
+    /// Ambient occlusion distance (Å).
+    #[arg(long, default_value_t = 4.0)]
+    pub ao_distance: f32,
+    /// Direction towards the (directional) light, world space `x,y,z`.
+    #[arg(long, value_parser = parse_dir)]
+    pub light_dir: Option<[f32; 3]>,
+    /// Light intensity (shadows: factor of max(0, n·l); path: irradiance / π).
+    #[arg(long, default_value_t = 0.85)]
+    pub light_intensity: f32,
+    /// Ambient term of --shadows shading.
+    #[arg(long, default_value_t = 0.2)]
+    pub ambient: f32,
+    /// vol+bs with --shadows (or path): shadow rays are attenuated by the volume's
+    /// transmittance (soft shadows, paper §4.5).
+    #[arg(long)]
+    pub volume_shadows: bool,
+    /// Step of shadow rays through the volume (voxels).
+    #[arg(long, default_value_t = 2.0)]
+    pub shadow_step: f32,
+    /// Path tracing: BRDF of the atoms.
+    #[arg(long, value_enum, default_value_t = MaterialArg::Metal)]
+    pub material: MaterialArg,
+    /// Path tracing: samples per pixel.
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Path tracing: maximum hits per path.
+    #[arg(long, default_value_t = 6)]
+    pub max_depth: u32,
+    /// Path tracing, metal: roughness (0 = mirror).
+    #[arg(long, default_value_t = 0.15)]
+    pub roughness: f32,
+    /// Path tracing: exposure (radiance multiplier before clamp and gamma 2).
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f32,
+    /// Seed of the random numbers (AO, path tracing).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// Traversal of shadow and AO rays: packets with any-hit exit, or single rays.
+    #[arg(long, value_enum, default_value_t = SecondaryArg::Packet)]
+    pub secondary: SecondaryArg,
     /// Volume: march every cell (no macrocell skipping), for comparison.
     #[arg(long)]
     pub no_macrocells: bool,
@@ -195,9 +278,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             .build_global()
             .context("--threads")?;
     }
-    if args.lit && args.mode == Mode::Bs {
-        bail!("--lit lights the volume: use it with --mode volume or --mode vol+bs");
-    }
+    check_modalities(&args)?;
     let mut input = args.input.clone();
     if input.file.is_none() && input.scene.is_none() {
         input.scene = Some(molecule::scenes::SceneName::Nanobowl);
@@ -229,7 +310,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     let (w, h) = args.size;
     let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
     drop(probe);
-    let tf = if args.mode == Mode::Bs {
+    let tf = if matches!(args.mode, Mode::Bs | Mode::Path) {
         None
     } else {
         Some(load_tf(&args.tf)?)
@@ -279,7 +360,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         ));
         Some(scene)
     };
-    let vol = if args.mode == Mode::Bs {
+    let vol = if matches!(args.mode, Mode::Bs | Mode::Path) {
         None
     } else {
         let (vol, cells, secs) = build_volume(isa, m, &args.volume)?;
@@ -324,10 +405,10 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             MarchOptions {
                 macrocells: !args.no_macrocells,
                 preintegrated: !args.no_preintegration,
-                lighting: if args.lit {
-                    Lighting::Headlight
-                } else {
-                    Lighting::Unlit
+                lighting: match (args.lit, args.light_dir) {
+                    (false, _) => Lighting::Unlit,
+                    (true, None) => Lighting::Headlight,
+                    (true, Some(l)) => Lighting::Directional(l),
                 },
                 ..MarchOptions::default()
             },
@@ -343,24 +424,162 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         background: render::rgba(r, g, b, 255),
         ..RenderOptions::default()
     };
-    let mut fb = Framebuffer::new(w, h, opt.background)?;
     let t = Instant::now();
-    let stats = render_frame_into(scene.as_ref(), vscene.as_ref(), &camera, &mut fb, &opt, isa);
-    verbose(format!(
-        "render:  {:.3} s  {}x{} {} ({:.1} Mrays/s, {:.2} fps)",
-        t.elapsed().as_secs_f64(),
-        w,
-        h,
-        args.mode.name(),
-        stats.mrays_per_s(),
-        stats.fps()
-    ));
+    let fb = match (modality(&args), &scene) {
+        (Some(modality), Some(scene)) => {
+            let topt = TraceOptions {
+                modality,
+                light_dir: args.light_dir.unwrap_or(TraceOptions::default().light_dir),
+                light_intensity: args.light_intensity,
+                ambient: args.ambient,
+                background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
+                seed: args.seed,
+                volume_shadows: args.volume_shadows,
+                shadow_step_voxels: args.shadow_step,
+                exposure: args.exposure,
+                secondary: match args.secondary {
+                    SecondaryArg::Packet => SecondaryTraversal::Packet,
+                    SecondaryArg::Single => SecondaryTraversal::Single,
+                },
+            };
+            let path = args.mode == Mode::Path;
+            let spp = if path { args.spp } else { 1 };
+            let mut acc = Accum::new(w, h)?;
+            let stats =
+                render_modal_into(scene, vscene.as_ref(), &camera, &mut acc, &topt, spp, isa);
+            let secs = stats.time.as_secs_f64();
+            verbose(format!(
+                "render:  {secs:.3} s  {w}x{h} {}{} ({:.2} fps{})",
+                args.mode.name(),
+                modality_name(&args),
+                1.0 / secs.max(1e-12),
+                if path {
+                    format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
+                } else {
+                    String::new()
+                }
+            ));
+            acc.to_framebuffer(path, args.exposure)
+        }
+        _ => {
+            let mut fb = Framebuffer::new(w, h, opt.background)?;
+            let stats =
+                render_frame_into(scene.as_ref(), vscene.as_ref(), &camera, &mut fb, &opt, isa);
+            verbose(format!(
+                "render:  {:.3} s  {}x{} {}{} ({:.1} Mrays/s, {:.2} fps)",
+                t.elapsed().as_secs_f64(),
+                w,
+                h,
+                args.mode.name(),
+                if args.lit { " lit" } else { "" },
+                stats.mrays_per_s(),
+                stats.fps()
+            ));
+            fb
+        }
+    };
     fb.save_png(&output)
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
-        "wrote {} ({w}x{h}, {}, {isa})",
+        "wrote {} ({w}x{h}, {}{}{}, {isa})",
         output.display(),
-        args.mode.name()
+        args.mode.name(),
+        modality_name(&args),
+        if args.lit { " lit" } else { "" }
     );
     Ok(())
+}
+
+/// Rejects combinations of modality flags that do nothing, with what to use instead.
+fn check_modalities(args: &RenderArgs) -> Result<()> {
+    let m = args.mode;
+    if args.lit && matches!(m, Mode::Bs | Mode::Path) {
+        bail!("--lit lights the volume: use it with --mode volume or --mode vol+bs");
+    }
+    if args.shadows && args.ao.is_some() {
+        bail!("--shadows and --ao are separate modalities: choose one");
+    }
+    if (args.shadows || args.ao.is_some()) && matches!(m, Mode::Volume | Mode::Path) {
+        bail!(
+            "--shadows and --ao shade ball-and-stick hits: use them with --mode bs or vol+bs \
+             (--mode path has its own lighting; for volumetric shadows use --mode volume \
+             --volume-shadows)"
+        );
+    }
+    if args.ao == Some(0) {
+        bail!("--ao N needs at least one sample");
+    }
+    if !(args.ao_distance > 0.0 && args.ao_distance.is_finite()) {
+        bail!("--ao-distance must be a positive number of Å");
+    }
+    if !(args.shadow_step > 0.0 && args.shadow_step.is_finite()) {
+        bail!("--shadow-step must be a positive number of voxels");
+    }
+    if args.spp == 0 {
+        bail!("--spp must be at least 1");
+    }
+    if args.max_depth == 0 {
+        bail!("--max-depth must be at least 1");
+    }
+    if !(args.roughness >= 0.0 && args.roughness.is_finite()) {
+        bail!("--roughness must be a non-negative number");
+    }
+    if !(args.exposure > 0.0 && args.exposure.is_finite()) {
+        bail!("--exposure must be a positive number");
+    }
+    if args.volume_shadows {
+        match m {
+            Mode::VolBs if args.shadows => {}
+            Mode::Volume => bail!(
+                "volumetric shadows of the volume alone (--mode volume --volume-shadows) are \
+                 not available yet; available: --mode vol+bs --shadows --volume-shadows \
+                 (ball-and-stick shadowed by the volume) and --mode volume --lit"
+            ),
+            _ => bail!(
+                "--volume-shadows attenuates shadow rays by the volume: use it with \
+                 --mode vol+bs --shadows"
+            ),
+        }
+    }
+    Ok(())
+}
+
+/// The ray tracing modality the flags ask for (`None`: the plain headlight / volume modes).
+fn modality(args: &RenderArgs) -> Option<Modality> {
+    if args.mode == Mode::Path {
+        return Some(Modality::Path {
+            material: match args.material {
+                MaterialArg::Metal => Material::Metal,
+                MaterialArg::Diffuse => Material::Diffuse,
+            },
+            max_depth: args.max_depth,
+            roughness: args.roughness,
+        });
+    }
+    if let Some(n) = args.ao {
+        return Some(Modality::Ao {
+            samples: n,
+            distance: args.ao_distance,
+        });
+    }
+    if args.shadows {
+        return Some(Modality::Direct { shadows: true });
+    }
+    None
+}
+
+/// Suffix naming the modality in reports.
+fn modality_name(args: &RenderArgs) -> String {
+    match modality(args) {
+        Some(Modality::Path { material, .. }) => format!(" {material:?}").to_lowercase(),
+        Some(Modality::Ao { samples, distance }) => format!(" ao {samples}x{distance}Å"),
+        Some(Modality::Direct { .. }) => {
+            if args.volume_shadows {
+                " shadows (volume-attenuated)".into()
+            } else {
+                " shadows".into()
+            }
+        }
+        None => String::new(),
+    }
 }

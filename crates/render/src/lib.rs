@@ -10,12 +10,17 @@ mod colormap;
 mod framebuffer;
 mod scene;
 mod tile;
+mod trace;
 
 pub use camera::{Camera, Projection, View};
 pub use colormap::{viridis, Colormap};
 pub use framebuffer::{Framebuffer, RenderError};
 pub use scene::{Coloring, Scene, SceneOptions, Style};
 pub use tile::{render_bs, render_bs_into, render_frame_into, RenderOptions, RenderStats, TILE};
+pub use trace::{
+    ambient_occlusion_at, occluded, render_modal, render_modal_into, trace, Accum, Material,
+    Modality, SecondaryTraversal, TraceOptions, Traced,
+};
 
 /// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
 pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {

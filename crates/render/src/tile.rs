@@ -154,18 +154,18 @@ fn render_tiles(
 
 /// Camera precomputed for a frame: ray of pixel (px, py) (pixel centres at +0.5) is
 /// `o = org + du·px + dv·py` (orthographic) or `d = normalize(dir0 + du·px + dv·py)`.
-struct ViewRays {
-    perspective: bool,
-    org: [f32; 3],
-    dir0: [f32; 3],
-    du: [f32; 3],
-    dv: [f32; 3],
-    width: f32,
-    height: f32,
+pub(crate) struct ViewRays {
+    pub(crate) perspective: bool,
+    pub(crate) org: [f32; 3],
+    pub(crate) dir0: [f32; 3],
+    pub(crate) du: [f32; 3],
+    pub(crate) dv: [f32; 3],
+    pub(crate) width: f32,
+    pub(crate) height: f32,
 }
 
 impl ViewRays {
-    fn new(c: &Camera, w: usize, h: usize) -> ViewRays {
+    pub(crate) fn new(c: &Camera, w: usize, h: usize) -> ViewRays {
         let (wf, hf) = (w.max(1) as f64, h.max(1) as f64);
         let v = |a: [f32; 3], k: f64| [a[0] as f64 * k, a[1] as f64 * k, a[2] as f64 * k];
         let add = |a: [f64; 3], b: [f64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -215,7 +215,7 @@ struct TileKernel<'a> {
 }
 
 /// Pixel block of a packet: `bw × bh = LANES`, as square as possible.
-const fn block_width(lanes: usize) -> usize {
+pub(crate) const fn block_width(lanes: usize) -> usize {
     match lanes {
         1 => 1,
         4 => 2,

@@ -56,6 +56,7 @@
 pub mod grid;
 pub mod macrocell;
 pub mod march;
+pub mod shadow;
 pub mod tf;
 
 pub use grid::{
@@ -66,6 +67,7 @@ pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{
     classify_values, march, march_rays, sample_points, Lighting, MarchOptions, Rays, VolumeScene,
 };
+pub use shadow::{transmittance, ShadowTf};
 pub use tf::{
     preintegrate, ClassifiedTf, ControlPoint, Preset, TfError, TransferFunction, TF_SIZE,
 };

@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use spmd::Isa;
 
+mod bench;
 mod generate;
 mod info;
 mod input;
@@ -21,9 +22,9 @@ struct Cli {
     version: bool,
 
     /// SIMD backend: scalar, sse4.1, avx2 or avx512 (default: BNS_ISA, else the widest the
-    /// CPU supports).
-    #[arg(long, global = true, value_name = "ISA")]
-    isa: Option<Isa>,
+    /// CPU supports); `bench` also takes `all` (every backend the CPU supports).
+    #[arg(long, global = true, value_name = "ISA", value_parser = parse_isa_arg)]
+    isa: Option<IsaArg>,
 
     #[command(subcommand)]
     command: Option<Command>,
@@ -40,6 +41,24 @@ enum Command {
     Render(Box<render_cmd::RenderArgs>),
     /// Write a built-in reference scene to a file (.xyz or .lammpstrj, optionally .gz).
     Generate(generate::GenerateArgs),
+    /// Reproduce the paper's Tables 1-3 on this machine: preprocessing figures and fps per
+    /// scene, mode, view, frame size, thread count and ISA, beside the paper's.
+    Bench(Box<bench::BenchArgs>),
+}
+
+/// `--isa`: one backend, or (for `bench`) all the CPU supports.
+#[derive(Clone, Copy, Debug)]
+enum IsaArg {
+    One(Isa),
+    All,
+}
+
+fn parse_isa_arg(s: &str) -> Result<IsaArg, spmd::IsaError> {
+    if s.trim().eq_ignore_ascii_case("all") {
+        Ok(IsaArg::All)
+    } else {
+        s.parse().map(IsaArg::One)
+    }
 }
 
 fn main() {
@@ -50,7 +69,14 @@ fn main() {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    let isa = Isa::select(cli.isa)?;
+    let requested = match cli.isa {
+        Some(IsaArg::One(i)) => Some(i),
+        Some(IsaArg::All) if !matches!(cli.command, Some(Command::Bench(_))) => {
+            anyhow::bail!("--isa all is only for `bnsview bench`; name one ISA")
+        }
+        _ => None,
+    };
+    let isa = Isa::select(requested)?;
     if cli.version {
         println!(
             "bnsview {} (isa: {isa}, {} lanes)",
@@ -64,6 +90,13 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Info(args)) => info::run(args),
         Some(Command::Render(args)) => render_cmd::run(*args, isa),
         Some(Command::Generate(args)) => generate::run(args),
+        Some(Command::Bench(args)) => {
+            let isas = match cli.isa {
+                Some(IsaArg::All) => Isa::supported(),
+                _ => vec![isa],
+            };
+            bench::run(*args, isas)
+        }
         None => {
             use clap::CommandFactory;
             Cli::command().print_help()?;

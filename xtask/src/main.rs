@@ -1,6 +1,7 @@
 //! Project chores: `cargo xtask matrix [--quick]` runs the test suite once per ISA the CPU
 //! has (with `BNS_ISA` forced), the criterion kernel benches, and portable builds for
-//! `-C target-cpu=x86-64 / x86-64-v3 / x86-64-v4`, then prints one table.
+//! `-C target-cpu=x86-64 / x86-64-v3 / x86-64-v4`, then prints one table. `cargo xtask bench
+//! [ARGS]` runs `bnsview bench ARGS` built in release mode.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -16,14 +17,40 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("matrix") => matrix(args[1..].iter().any(|a| a == "--quick")),
+        Some("bench") => bench(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask matrix [--quick]");
+            eprintln!("usage: cargo xtask matrix [--quick] | cargo xtask bench [BENCH ARGS]");
             eprintln!("  matrix   tests per ISA, kernel benches with speedups over scalar,");
             eprintln!("           builds for target-cpu x86-64 / x86-64-v3 / x86-64-v4");
             eprintln!("  --quick  short bench runs (criterion --quick)");
+            eprintln!("  bench    `bnsview bench` in release mode (the paper's Tables 1-3);");
+            eprintln!("           e.g. cargo xtask bench --quick --json out.json");
             std::process::exit(2)
         }
     }
+}
+
+/// `cargo xtask bench ARGS` = `cargo run --release -p bnsview -- bench ARGS`; a global
+/// `--isa X` among ARGS is passed through (clap accepts it after the subcommand).
+fn bench(args: &[String]) -> Result<()> {
+    let status = cargo()
+        .args([
+            "run",
+            "--release",
+            "-p",
+            "bnsview",
+            "--bin",
+            "bnsview",
+            "--",
+            "bench",
+        ])
+        .args(args)
+        .status()
+        .context("running cargo run --release -- bench")?;
+    if !status.success() {
+        bail!("bnsview bench failed ({status})");
+    }
+    Ok(())
 }
 
 fn root() -> PathBuf {

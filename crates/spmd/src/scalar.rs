@@ -23,7 +23,7 @@ fn bounds(idx: i32, len: usize) -> usize {
 /// Larger magnitudes, infinities and NaN are already integral and returned as they are.
 #[inline(always)]
 fn round_toward(a: f32, up: bool) -> f32 {
-    if !(a.abs() < 8_388_608.0) {
+    if a.is_nan() || a.abs() >= 8_388_608.0 {
         return a;
     }
     let t = a as i32 as f32;

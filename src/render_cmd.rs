@@ -161,9 +161,9 @@ pub struct RenderArgs {
     /// Path tracing: exposure (radiance multiplier before clamp and gamma 2).
     #[arg(long, default_value_t = 1.0)]
     pub exposure: f32,
-    /// Seed of the random numbers (AO, path tracing).
+    /// Seed of the random numbers of AO and path tracing (`--seed` seeds scene generators).
     #[arg(long, default_value_t = 1)]
-    pub seed: u32,
+    pub sample_seed: u32,
     /// Traversal of shadow and AO rays: packets with any-hit exit, or single rays.
     #[arg(long, value_enum, default_value_t = SecondaryArg::Packet)]
     pub secondary: SecondaryArg,
@@ -433,7 +433,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
                 light_intensity: args.light_intensity,
                 ambient: args.ambient,
                 background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
-                seed: args.seed,
+                seed: args.sample_seed,
                 volume_shadows: args.volume_shadows,
                 shadow_step_voxels: args.shadow_step,
                 exposure: args.exposure,

@@ -142,3 +142,64 @@ fn render_reports_bad_input_with_file_and_line() {
         .arg(d.join("y.png")));
     assert!(!ok && err.contains("same point"), "{err}");
 }
+
+/// Each ray tracing modality renders a PNG; unavailable or meaningless combinations are
+/// refused with a message saying what is available.
+#[test]
+fn render_modalities_write_pngs_and_refuse_what_is_missing() {
+    let dir = std::env::temp_dir().join(format!("bnsview-modal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [&[&str]; 5] = [
+        &["--shadows"],
+        &["--ao", "2"],
+        &["--mode", "path", "--spp", "2", "--material", "metal"],
+        &["--mode", "path", "--spp", "1", "--material", "diffuse"],
+        &[
+            "--mode",
+            "vol+bs",
+            "--shadows",
+            "--volume-shadows",
+            "--voxels-per-angstrom",
+            "1",
+        ],
+    ];
+    for (i, extra) in cases.iter().enumerate() {
+        let out = dir.join(format!("m{i}.png"));
+        let (ok, _, err) = run(bnsview()
+            .args([
+                "render", "--scene", "nanobowl", "--atoms", "2000", "--size", "48x40", "-f",
+            ])
+            .args(*extra)
+            .arg("-o")
+            .arg(&out));
+        assert!(ok, "{extra:?}: {err}");
+        assert!(out.exists(), "{extra:?}");
+    }
+    let (ok, _, err) = run(bnsview()
+        .args([
+            "render",
+            "--scene",
+            "nanobowl",
+            "--atoms",
+            "2000",
+            "--mode",
+            "volume",
+            "--volume-shadows",
+            "-o",
+        ])
+        .arg(dir.join("x.png")));
+    assert!(!ok && err.contains("not available"), "{err}");
+    let (ok, _, err) = run(bnsview()
+        .args([
+            "render",
+            "--scene",
+            "nanobowl",
+            "--shadows",
+            "--ao",
+            "4",
+            "-o",
+        ])
+        .arg(dir.join("y.png")));
+    assert!(!ok && err.contains("choose one"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -816,12 +816,18 @@ fn modal_tile<S: Simd>(s: S, k: ModalKernel<'_>) {
             s.store(sum.x * w, &mut buf[0]);
             s.store(sum.y * w, &mut buf[1]);
             s.store(sum.z * w, &mut buf[2]);
-            for i in 0..S::LANES {
+            for (i, ((r, g), b)) in buf[0]
+                .iter()
+                .zip(&buf[1])
+                .zip(&buf[2])
+                .take(S::LANES)
+                .enumerate()
+            {
                 let (x, y) = (bx + i % bw, by + i / bw);
                 let o = 3 * (y * TILE + x);
-                k.out[o] += buf[0][i];
-                k.out[o + 1] += buf[1][i];
-                k.out[o + 2] += buf[2][i];
+                k.out[o] += r;
+                k.out[o + 1] += g;
+                k.out[o + 2] += b;
             }
         }
     }

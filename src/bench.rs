@@ -567,10 +567,10 @@ fn atoms_sphere(m: &molecule::Molecule, g: &GeometryArgs) -> ([f32; 3], f32) {
         .collect();
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
-    for i in 0..m.len() {
+    for (i, &ri) in r.iter().enumerate() {
         for (k, c) in [m.x[i], m.y[i], m.z[i]].into_iter().enumerate() {
-            lo[k] = lo[k].min(c - r[i]);
-            hi[k] = hi[k].max(c + r[i]);
+            lo[k] = lo[k].min(c - ri);
+            hi[k] = hi[k].max(c + ri);
         }
     }
     let c = [
@@ -1019,14 +1019,15 @@ fn bench_scene(
             (true, false) => unlit.as_ref(),
             (true, true) => lit.as_ref(),
         };
-        if !pools.contains_key(&key.threads) {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(key.threads as usize)
-                .build()
-                .context("building a thread pool")?;
-            pools.insert(key.threads, pool);
-        }
-        let pool = &pools[&key.threads];
+        let pool = match pools.entry(key.threads) {
+            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::btree_map::Entry::Vacant(e) => e.insert(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(key.threads as usize)
+                    .build()
+                    .context("building a thread pool")?,
+            ),
+        };
         for &isa in isas {
             let ms = pool.install(|| {
                 for _ in 0..a.warmup {

@@ -712,10 +712,26 @@ fn run_report(files: &[PathBuf]) -> Result<()> {
             load.0 = l.0;
         }
         load.1 = l.1;
-        pre.retain(|x| !p.iter().any(|y| y.scene == x.scene));
-        pre.extend(p);
-        meas.retain(|x| !m.iter().any(|y| y.key == x.key && y.isa == x.isa));
-        meas.extend(m);
+        for mut q in p {
+            // A later run of the same scene wins, but keeps what only the earlier one built
+            // (e.g. a volume-only run has no BVH figures).
+            if let Some(i) = pre.iter().position(|x| x.scene == q.scene) {
+                let old = pre.remove(i);
+                q.bvh_s = q.bvh_s.or(old.bvh_s);
+                q.volume_s = q.volume_s.or(old.volume_s);
+                q.geometry_bytes = q.geometry_bytes.or(old.geometry_bytes);
+                q.bvh_bytes = q.bvh_bytes.or(old.bvh_bytes);
+                q.volume_bytes = q.volume_bytes.or(old.volume_bytes);
+            }
+            pre.push(q);
+        }
+        for mut q in m {
+            // The same measurement in a later file wins and belongs to both files' tables.
+            if let Some(i) = meas.iter().position(|x| x.key == q.key && x.isa == q.isa) {
+                q.tables |= meas.remove(i).tables;
+            }
+            meas.push(q);
+        }
         wall += w;
     }
     pre.sort_by_key(|p| sidx(p.scene));

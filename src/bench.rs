@@ -107,11 +107,12 @@ pub struct BenchArgs {
     /// Views of Table 3 (comma separated; default far,close).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub views: Option<Vec<ViewArg>>,
-    /// Frame size of Tables 2 and 3, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1024x1024", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Frame size of Tables 2 and 3, WIDTHxHEIGHT (default 1024x1024 as in the paper, with
+    /// --quick 512x512).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Frame sizes of Table 1 (comma separated, N for N×N or WxH; default 256 … 4096, with
-    /// --quick 256 … 1024).
+    /// --quick 256 and 512).
     #[arg(long, value_delimiter = ',', value_parser = parse_side)]
     pub sizes: Option<Vec<(u32, u32)>>,
     /// Thread counts (comma separated). Table 2 default: 1 … nproc; Tables 1 and 3 default:
@@ -124,8 +125,8 @@ pub struct BenchArgs {
     /// Warm-up frames before timing.
     #[arg(long, default_value_t = 1)]
     pub warmup: usize,
-    /// Small scenes (nanobowl and ns90k full, the others 100K atoms), 3 frames, Table 1 up to
-    /// 1024²: a run of a few minutes.
+    /// Small scenes (nanobowl and ns90k full, the others 100K atoms), 512² frames (Table 1:
+    /// 256² and 512²), 3 frames after the warm-up: a run of a few minutes.
     #[arg(long)]
     pub quick: bool,
     /// Atoms per scene (overrides the paper's count and --quick).
@@ -152,6 +153,10 @@ pub struct BenchArgs {
     /// Overwrite the JSON file if it exists.
     #[arg(short, long)]
     pub force: bool,
+    /// Measure nothing: print the tables of earlier runs from their JSON files (repeat the
+    /// flag to merge runs; a later file's record of the same measurement wins).
+    #[arg(long, value_name = "FILE", conflicts_with = "json")]
+    pub report: Vec<PathBuf>,
 }
 
 /// Parses `N` (N×N) or `WxH`.
@@ -267,6 +272,9 @@ fn plan(a: &BenchArgs, nproc: u32) -> Vec<(Key, u8)> {
         None => out.push((k, t)),
     };
     let default_threads = vec![nproc];
+    let size = a
+        .size
+        .unwrap_or(if a.quick { (512, 512) } else { (1024, 1024) });
     if want(TableSel::T3) {
         let modes = a.modes.clone().unwrap_or_else(|| BenchMode::PAPER.to_vec());
         let views = a
@@ -283,8 +291,8 @@ fn plan(a: &BenchArgs, nproc: u32) -> Vec<(Key, u8)> {
                                 scene,
                                 mode,
                                 far: *v == ViewArg::Far,
-                                w: a.size.0,
-                                h: a.size.1,
+                                w: size.0,
+                                h: size.1,
                                 threads: t,
                             },
                             T3,
@@ -296,7 +304,7 @@ fn plan(a: &BenchArgs, nproc: u32) -> Vec<(Key, u8)> {
     }
     if want(TableSel::T1) {
         let sizes = a.sizes.clone().unwrap_or_else(|| {
-            let max = if a.quick { 1024 } else { 4096 };
+            let max = if a.quick { 512 } else { 4096 };
             [256, 512, 1024, 2048, 4096]
                 .into_iter()
                 .filter(|&s| s <= max)
@@ -331,8 +339,8 @@ fn plan(a: &BenchArgs, nproc: u32) -> Vec<(Key, u8)> {
                         scene,
                         mode: BenchMode::Volume,
                         far: true,
-                        w: a.size.0,
-                        h: a.size.1,
+                        w: size.0,
+                        h: size.1,
                         threads: t,
                     },
                     T2,
@@ -559,7 +567,7 @@ fn atoms_sphere(m: &molecule::Molecule, g: &GeometryArgs) -> ([f32; 3], f32) {
         .collect();
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
-    for (i, &ri) in r.iter().enumerate().take(m.len()) {
+    for (i, &ri) in r.iter().enumerate() {
         for (k, c) in [m.x[i], m.y[i], m.z[i]].into_iter().enumerate() {
             lo[k] = lo[k].min(c - ri);
             hi[k] = hi[k].max(c + ri);
@@ -602,8 +610,155 @@ fn write_json(path: &Path, doc: &Value) -> Result<()> {
     Ok(())
 }
 
+/// Reads the records of an earlier run.
+type Loads = ([f64; 3], [f64; 3]);
+
+fn read_report(path: &Path) -> Result<(Vec<Preprocess>, Vec<Measurement>, Loads, f64)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let doc: Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let bad = |what: &str| anyhow::anyhow!("{}: record without a valid {what}", path.display());
+    let mut pre = Vec::new();
+    let mut meas = Vec::new();
+    for r in doc["records"]
+        .as_array()
+        .ok_or_else(|| bad("records array"))?
+    {
+        let scene: SceneName = r["scene"]
+            .as_str()
+            .and_then(|s| s.parse().ok())
+            .ok_or_else(|| bad("scene"))?;
+        let num = |k: &str| r[k].as_f64();
+        let bytes = |k: &str| num(k).map(|v| (v * 1e6).round() as u64);
+        match r["kind"].as_str() {
+            Some("preprocess") => pre.push(Preprocess {
+                scene,
+                atoms: num("atoms").ok_or_else(|| bad("atoms"))? as usize,
+                bonds: num("bonds").unwrap_or(0.0) as usize,
+                load_s: num("load_s").unwrap_or(f64::NAN),
+                bond_s: num("bond_s").unwrap_or(f64::NAN),
+                bvh_s: num("bvh_s"),
+                volume_s: num("volume_s"),
+                geometry_bytes: bytes("geometry_mb"),
+                bvh_bytes: bytes("bvh_mb"),
+                volume_bytes: bytes("volume_mb"),
+                voxels_per_angstrom: num("voxels_per_angstrom").unwrap_or(f64::NAN) as f32,
+                volume_dims: None,
+                peak_rss_mb: num("peak_rss_mb"),
+                peak_rss_reset: r["peak_rss_scope"] == "this scene",
+            }),
+            Some("frame") => {
+                let mode = r["mode"]
+                    .as_str()
+                    .and_then(|m| BenchMode::from_str(m, true).ok())
+                    .ok_or_else(|| bad("mode"))?;
+                let isa: Isa = r["isa"]
+                    .as_str()
+                    .and_then(|m| m.parse().ok())
+                    .ok_or_else(|| bad("isa"))?;
+                let mut tables = 0u8;
+                for t in r["tables"].as_array().into_iter().flatten() {
+                    tables |= match t.as_u64() {
+                        Some(1) => T1,
+                        Some(2) => T2,
+                        Some(3) => T3,
+                        _ => 0,
+                    };
+                }
+                let ms: Vec<f64> = match r["ms_all"].as_array() {
+                    Some(v) => v.iter().filter_map(Value::as_f64).collect(),
+                    None => vec![num("ms_median").ok_or_else(|| bad("ms_median"))?],
+                };
+                let key = Key {
+                    scene,
+                    mode,
+                    far: r["view"] == "far",
+                    w: num("width").ok_or_else(|| bad("width"))? as u32,
+                    h: num("height").ok_or_else(|| bad("height"))? as u32,
+                    threads: num("threads").ok_or_else(|| bad("threads"))? as u32,
+                };
+                meas.push(Measurement {
+                    key,
+                    tables,
+                    atoms: num("atoms").unwrap_or(0.0) as usize,
+                    isa,
+                    ms,
+                    load1: num("load_avg_1min").unwrap_or(f64::NAN),
+                });
+            }
+            _ => return Err(bad("kind")),
+        }
+    }
+    let load =
+        |k: &str| -> [f64; 3] { serde_json::from_value(doc[k].clone()).unwrap_or([f64::NAN; 3]) };
+    Ok((
+        pre,
+        meas,
+        (load("load_avg_start"), load("load_avg_end")),
+        doc["wall_s"].as_f64().unwrap_or(f64::NAN),
+    ))
+}
+
+/// `bnsview bench --report FILE...`: the tables of earlier runs, merged.
+fn run_report(files: &[PathBuf]) -> Result<()> {
+    let mut pre: Vec<Preprocess> = Vec::new();
+    let mut meas: Vec<Measurement> = Vec::new();
+    let mut load = ([f64::NAN; 3], [f64::NAN; 3]);
+    let mut wall = 0.0;
+    for (i, f) in files.iter().enumerate() {
+        let (p, m, l, w) = read_report(f)?;
+        if i == 0 {
+            load.0 = l.0;
+        }
+        load.1 = l.1;
+        for mut q in p {
+            // A later run of the same scene wins, but keeps what only the earlier one built
+            // (e.g. a volume-only run has no BVH figures).
+            if let Some(i) = pre.iter().position(|x| x.scene == q.scene) {
+                let old = pre.remove(i);
+                q.bvh_s = q.bvh_s.or(old.bvh_s);
+                q.volume_s = q.volume_s.or(old.volume_s);
+                q.geometry_bytes = q.geometry_bytes.or(old.geometry_bytes);
+                q.bvh_bytes = q.bvh_bytes.or(old.bvh_bytes);
+                q.volume_bytes = q.volume_bytes.or(old.volume_bytes);
+            }
+            pre.push(q);
+        }
+        for mut q in m {
+            // The same measurement in a later file wins and belongs to both files' tables.
+            if let Some(i) = meas.iter().position(|x| x.key == q.key && x.isa == q.isa) {
+                q.tables |= meas.remove(i).tables;
+            }
+            meas.push(q);
+        }
+        wall += w;
+    }
+    pre.sort_by_key(|p| sidx(p.scene));
+    let mut isas: Vec<Isa> = meas.iter().map(|m| m.isa).collect();
+    isas.sort();
+    isas.dedup();
+    let nproc = std::thread::available_parallelism()
+        .map(|n| n.get() as u32)
+        .unwrap_or(1);
+    let mut out = format!(
+        "Report of {}",
+        files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    report(&mut out, &pre, &meas, &isas, nproc, load, wall);
+    print!("{out}");
+    Ok(())
+}
+
 /// Run `bnsview bench` on the backends `isas`.
 pub fn run(a: BenchArgs, isas: Vec<Isa>) -> Result<()> {
+    if !a.report.is_empty() {
+        return run_report(&a.report);
+    }
     if isas.is_empty() {
         bail!("no ISA to benchmark");
     }
@@ -711,7 +866,15 @@ pub fn run(a: BenchArgs, isas: Vec<Isa>) -> Result<()> {
     }
 
     let mut out = String::new();
-    report(&mut out, &pre, &meas, &isas, nproc, load_start, wall);
+    report(
+        &mut out,
+        &pre,
+        &meas,
+        &isas,
+        nproc,
+        (load_start, load_avg()),
+        wall,
+    );
     print!("{out}");
     if let Some(p) = &a.json {
         eprintln!(
@@ -872,15 +1035,15 @@ fn bench_scene(
             (true, false) => unlit.as_ref(),
             (true, true) => lit.as_ref(),
         };
-        if let std::collections::btree_map::Entry::Vacant(e) = pools.entry(key.threads) {
-            e.insert(
+        let pool = match pools.entry(key.threads) {
+            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::btree_map::Entry::Vacant(e) => e.insert(
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(key.threads as usize)
                     .build()
                     .context("building a thread pool")?,
-            );
-        }
-        let pool = &pools[&key.threads];
+            ),
+        };
         for &isa in isas {
             let ms = pool.install(|| {
                 for _ in 0..a.warmup {
@@ -953,11 +1116,10 @@ fn report(
     meas: &[Measurement],
     isas: &[Isa],
     nproc: u32,
-    load_start: [f64; 3],
+    (load_start, load_end): ([f64; 3], [f64; 3]),
     wall: f64,
 ) {
     use std::fmt::Write as _;
-    let load_end = load_avg();
     let _ = writeln!(
         o,
         "\nbnsview bench on {} ({} cores), ISA {}; load average {:.2} {:.2} {:.2} at start, {:.2} {:.2} {:.2} at end; wall {:.0} s",
@@ -1024,10 +1186,19 @@ fn report(
         .map(|m| (m.isa, m.key.w, m.key.h, m.key.threads))
         .collect();
     for (isa, w, h, threads) in combos {
+        // The paper measured at 1024²: at other sizes compare per pixel (ours × pixels/1024²).
+        let scale = w as f64 * h as f64 / (1024.0 * 1024.0);
         let _ = writeln!(
             o,
-            "### Table 3: fps far / close, {w}x{h}, {isa}, {threads} thread{}\n",
-            if threads == 1 { "" } else { "s" }
+            "### Table 3: fps far / close, {w}x{h}, {isa}, {threads} thread{}{}\n",
+            if threads == 1 { "" } else { "s" },
+            if scale == 1.0 {
+                String::new()
+            } else {
+                format!(
+                    " (paper at 1024²: per-core columns scale ours by {scale:.3}, the pixel ratio)"
+                )
+            }
         );
         let _ = writeln!(
             o,
@@ -1054,7 +1225,7 @@ fn report(
             let ours = [f.map(|m| m.fps()), c.map(|m| m.fps())];
             let paper = mode.paper_row().map(|r| paper_table3(scene)[r]);
             let pair = |a: Option<f64>, b: Option<f64>| format!("{} / {}", opt_f(a), opt_f(b));
-            let per_core = |x: Option<f64>| x.map(|v| v / threads as f64);
+            let per_core = |x: Option<f64>| x.map(|v| v * scale / threads as f64);
             let paper_core = |i: usize| paper.map(|p| p[i] / PAPER_CORES);
             let ratio = |i: usize| match (per_core(ours[i]), paper_core(i)) {
                 (Some(a), Some(b)) => Some(a / b),
@@ -1138,9 +1309,17 @@ fn report(
         .collect();
     for (si, isa, w, h) in combos {
         let scene = SceneName::ALL[si];
+        let scale = w as f64 * h as f64 / (1024.0 * 1024.0);
         let _ = writeln!(
             o,
-            "### Table 2: {scene} far, volume, {w}x{h}, by threads, {isa}\n"
+            "### Table 2: {scene} far, volume, {w}x{h}, by threads, {isa}{}\n",
+            if scale == 1.0 {
+                String::new()
+            } else {
+                format!(
+                    " (paper at 1024²: ours ÷ paper scales ours by {scale:.3}, the pixel ratio)"
+                )
+            }
         );
         let _ = writeln!(
             o,
@@ -1174,7 +1353,7 @@ fn report(
                     .map(|p| format!("{:.2}×", p / PAPER_TABLE2[0].1))
                     .unwrap_or("-".into()),
                 paper
-                    .map(|p| format!("{:.2}×", m.fps() / p))
+                    .map(|p| format!("{:.2}×", m.fps() * scale / p))
                     .unwrap_or("-".into()),
             );
         }
@@ -1322,6 +1501,28 @@ mod tests {
         let p = plan(&args(&["--table", "2"]), 4);
         let t: Vec<u32> = p.iter().map(|(k, _)| k.threads).collect();
         assert_eq!(t, [1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn volume_only_runs_see_the_same_frame_as_geometry_runs() {
+        // The camera of a volume-only run (no BVH) is fitted to the same sphere as Scene's.
+        let m = molecule::scenes::generate(SceneName::Ns90k, Some(3000), 7);
+        let bonds = molecule::bonds::build_bonds(&m, &Default::default());
+        let g = args(&[]).geometry;
+        let (scene, _) = build_scene(&m, &bonds, &g).unwrap();
+        let (c, r) = atoms_sphere(&m, &g);
+        for k in 0..3 {
+            assert!(
+                (c[k] - scene.center[k]).abs() < 1e-3 * scene.radius,
+                "{c:?} {:?}",
+                scene.center
+            );
+        }
+        assert!(
+            (r - scene.radius).abs() < 1e-3 * scene.radius,
+            "{r} {}",
+            scene.radius
+        );
     }
 
     #[test]

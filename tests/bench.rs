@@ -152,7 +152,18 @@ fn tiny_table3_run_writes_a_record_per_measurement() {
     );
     assert!(stdout.contains("Table 3"), "{stdout}");
     // The paper's nanobowl b&s figures are printed beside ours.
-    assert!(stdout.contains("63 / 55"), "{stdout}");
+    assert!(stdout.contains("63.0 / 55.0"), "{stdout}");
+
+    // --report prints the same tables again from the file.
+    let (again, _) = run_ok(bnsview().args(["bench", "--report"]).arg(&json));
+    let table3 = |s: &str| -> Vec<String> {
+        s.lines()
+            .filter(|l| l.starts_with("| nanobowl | ") && l.contains(" / "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(table3(&again), table3(&stdout));
+    assert_eq!(table3(&again).len(), 4);
 
     // An existing file is not overwritten without --force.
     let out = bnsview()

@@ -82,9 +82,9 @@ pub enum Modality {
 
 /// How shadow and AO rays traverse the BVH.
 ///
-/// Measured (1024², 2 threads, nanobowl far view, AVX-512; fps):
-/// see the crate README / final report; `Packet` is the default because it was faster on
-/// every backend with more than one lane.
+/// Measured (ns90k, 1024², far view, 2 threads, AVX-512, one frame on a loaded machine):
+/// shadows 0.370 s packet vs 0.659 s single; AO 4 samples 0.903 s packet vs 1.887 s single.
+/// So `Packet` (any-hit, early exit) is the default for both ray kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SecondaryTraversal {
     /// The incoherent rays of a pixel block as one packet, any-hit early exit.

@@ -224,7 +224,29 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     fn gather_i(self, s: &[i32], idx: Self::I32, m: Self::M, fill: Self::I32) -> Self::I32;
     /// `m ? s[idx] as i32 : 0` per lane (zero-extended bytes, e.g. a quantised volume), as
     /// [`Simd::gather`].
-    fn gather_u8(self, s: &[u8], idx: Self::I32, m: Self::M) -> Self::I32;
+    #[inline(always)]
+    fn gather_u8(self, s: &[u8], idx: Self::I32, m: Self::M) -> Self::I32 {
+        self.gather_u8x4(s, idx, m) & self.splat_i(0xff)
+    }
+    /// `m ? le_u32(s[idx..idx + 4]) : 0` per lane: the four bytes from `idx` on, little
+    /// endian (byte `idx` in bits 0-7), bytes past the end of `s` reading as 0 — two x-neighbours
+    /// of a quantised volume in one gather. Panics if an active lane's `idx` is outside `s`, as
+    /// [`Simd::gather`].
+    fn gather_u8x4(self, s: &[u8], idx: Self::I32, m: Self::M) -> Self::I32;
+}
+
+/// The four bytes of `s` from `i` on as a little-endian `i32`, zero past the end (the lane
+/// form of [`Simd::gather_u8x4`]). `i` must be inside `s`.
+#[inline(always)]
+fn le_bytes4(s: &[u8], i: usize) -> i32 {
+    match s.get(i..i + 4) {
+        Some(w) => i32::from_le_bytes([w[0], w[1], w[2], w[3]]),
+        None => {
+            let mut w = [0u8; 4];
+            w[..s.len() - i].copy_from_slice(&s[i..]);
+            i32::from_le_bytes(w)
+        }
+    }
 }
 
 /// Panics unless every active lane's index is inside a slice of `len` elements.

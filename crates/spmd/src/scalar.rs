@@ -3,7 +3,7 @@
 
 use core::num::Wrapping;
 
-use crate::{gather_out_of_bounds, Isa, Simd};
+use crate::{gather_out_of_bounds, le_bytes4, Isa, Simd};
 
 /// The scalar reference backend (1 lane). Always available.
 #[derive(Clone, Copy, Debug, Default)]
@@ -314,6 +314,14 @@ impl Simd for Scalar {
     fn gather_u8(self, s: &[u8], idx: Wrapping<i32>, m: bool) -> Wrapping<i32> {
         if m {
             Wrapping(s[bounds(idx.0, s.len())] as i32)
+        } else {
+            Wrapping(0)
+        }
+    }
+    #[inline(always)]
+    fn gather_u8x4(self, s: &[u8], idx: Wrapping<i32>, m: bool) -> Wrapping<i32> {
+        if m {
+            Wrapping(le_bytes4(s, bounds(idx.0, s.len())))
         } else {
             Wrapping(0)
         }

@@ -449,15 +449,18 @@ proptest! {
         for isa in backends() {
             let got = isa.dispatch(Gathers { data: &data, ints: &ints, bytes: &bytes, idx: &idx, on: &mask_bits, fill });
             for k in 0..N {
-                let (wf, wi, wb) = if mask_bits[k] {
+                let (wf, wi, wb, w4) = if mask_bits[k] {
                     let i = idx[k] as usize;
-                    (data[i], ints[i], bytes[i] as i32)
+                    // Four bytes from i on, little endian, zero past the end.
+                    let w4 = (0..4).filter(|j| i + j < len).fold(0u32, |w, j| w | (bytes[i + j] as u32) << (8 * j));
+                    (data[i], ints[i], bytes[i] as i32, w4 as i32)
                 } else {
-                    (fill, fill.to_bits() as i32, 0)
+                    (fill, fill.to_bits() as i32, 0, 0)
                 };
                 prop_assert!(same_float(got.0[k], wf), "{} gather lane {}: got {} want {}", isa, k, got.0[k], wf);
                 prop_assert_eq!(got.1[k], wi, "{} gather_i lane {}", isa, k);
                 prop_assert_eq!(got.2[k], wb, "{} gather_u8 lane {} (len {}, idx {})", isa, k, len, idx[k]);
+                prop_assert_eq!(got.3[k], w4, "{} gather_u8x4 lane {} (len {}, idx {})", isa, k, len, idx[k]);
             }
         }
     }
@@ -519,10 +522,10 @@ struct Gathers<'a> {
 }
 
 impl Kernel for Gathers<'_> {
-    type Output = (Vec<f32>, Vec<i32>, Vec<i32>);
+    type Output = (Vec<f32>, Vec<i32>, Vec<i32>, Vec<i32>);
     #[inline(always)]
     fn run<S: Simd>(self, s: S) -> Self::Output {
-        let (mut f, mut i, mut b) = (vec![0.0; N], vec![0; N], vec![0; N]);
+        let (mut f, mut i, mut b, mut b4) = (vec![0.0; N], vec![0; N], vec![0; N], vec![0; N]);
         for k in (0..N).step_by(S::LANES) {
             let bits = (0..S::LANES).fold(0u32, |acc, l| acc | (self.on[k + l] as u32) << l);
             let m = s.mask_from_bits(bits);
@@ -534,8 +537,9 @@ impl Kernel for Gathers<'_> {
                 &mut i[k..],
             );
             s.store_i(s.gather_u8(self.bytes, idx, m), &mut b[k..]);
+            s.store_i(s.gather_u8x4(self.bytes, idx, m), &mut b4[k..]);
         }
-        (f, i, b)
+        (f, i, b, b4)
     }
 }
 
@@ -607,29 +611,43 @@ impl Kernel for Horizontal<'_> {
 /// A gather whose active lane points outside the slice must panic, never read.
 #[test]
 fn gather_out_of_bounds_active_lane_panics() {
-    struct Oob(i32);
+    /// Lane 0 gathers at `.0` (the others at 0) from a 5-element slice: f32 (`.1` false) or
+    /// 4-byte words (`.1` true); returns lane 0's value.
+    struct Oob(i32, bool);
     impl Kernel for Oob {
-        type Output = f32;
+        type Output = i32;
         #[inline(always)]
-        fn run<S: Simd>(self, s: S) -> f32 {
-            let data = [1.0f32; 5];
+        fn run<S: Simd>(self, s: S) -> i32 {
             let idx = s.select_i(
                 s.eq_i(s.lane_index(), s.splat_i(0)),
                 s.splat_i(self.0),
                 s.splat_i(0),
             );
-            s.reduce_add(s.gather(&data, idx, s.splat_m(true), s.splat(0.0)))
+            let all = s.splat_m(true);
+            let v = if self.1 {
+                s.gather_u8x4(&[7u8, 1, 2, 3, 9], idx, all)
+            } else {
+                s.to_i32(s.gather(&[1.0, 2.0, 3.0, 4.0, 5.0], idx, all, s.splat(0.0)))
+            };
+            let mut out = [0i32; spmd::MAX_LANES];
+            s.store_i(v, &mut out);
+            out[0]
         }
     }
     for isa in backends() {
-        for bad in [5, 6, -1, i32::MAX, i32::MIN] {
-            let r = std::panic::catch_unwind(|| isa.dispatch(Oob(bad)));
-            assert!(
-                r.is_err(),
-                "{isa}: gather at index {bad} of a 5-element slice did not panic"
-            );
+        for bytes in [false, true] {
+            for bad in [5, 6, -1, i32::MAX, i32::MIN] {
+                let r = std::panic::catch_unwind(|| isa.dispatch(Oob(bad, bytes)));
+                assert!(
+                    r.is_err(),
+                    "{isa}: gather (bytes: {bytes}) at index {bad} of a 5-element slice did not panic"
+                );
+            }
         }
-        assert_eq!(isa.dispatch(Oob(4)), isa.lanes() as f32);
+        assert_eq!(isa.dispatch(Oob(4, false)), 5);
+        // The last byte alone: the three past the end read as zero.
+        assert_eq!(isa.dispatch(Oob(4, true)), 9);
+        assert_eq!(isa.dispatch(Oob(1, true)), 0x0903_0201);
     }
 }
 

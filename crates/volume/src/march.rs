@@ -18,7 +18,7 @@
 
 use spmd::{Isa, Kernel, Simd, V3};
 
-use crate::grid::{Volume, VolumeData};
+use crate::grid::{Grid, Volume, VolumeData};
 use crate::macrocell::{Macrocells, MACROCELL};
 use crate::tf::ClassifiedTf;
 
@@ -98,35 +98,42 @@ impl<'a> VolumeScene<'a> {
 }
 
 /// Where voxel values come from, so the kernel is compiled once per storage format.
-trait Voxels: Copy {
-    /// `m ? value[idx] : 0` (raw: quantised units for u8).
-    fn fetch<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> S::F32;
+pub(crate) trait Voxels: Copy {
+    /// `m ? (value[idx], value[idx + 1]) : (0, 0)`: two x-neighbours (raw: quantised units for
+    /// u8).
+    fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32);
 }
 
 #[derive(Clone, Copy)]
-struct F32Voxels<'a>(&'a [f32]);
+pub(crate) struct F32Voxels<'a>(pub(crate) &'a [f32]);
 #[derive(Clone, Copy)]
-struct U8Voxels<'a>(&'a [u8]);
+pub(crate) struct U8Voxels<'a>(pub(crate) &'a [u8]);
 
 impl Voxels for F32Voxels<'_> {
     #[inline(always)]
-    fn fetch<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> S::F32 {
-        s.gather(self.0, idx, m, s.splat(0.0))
+    fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32) {
+        let z = s.splat(0.0);
+        let a = s.gather(self.0, idx, m, z);
+        (a, s.gather(self.0, idx + s.splat_i(1), m, z))
     }
 }
 impl Voxels for U8Voxels<'_> {
+    // One 4-byte gather serves both neighbours (8 → 4 gathers per sample): ns740k far
+    // volume at 1024², AVX-512, 1 thread, old and new side by side: 5.32 → 4.16 s (1.28×).
     #[inline(always)]
-    fn fetch<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> S::F32 {
-        s.to_f32(s.gather_u8(self.0, idx, m))
+    fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32) {
+        let w = s.gather_u8x4(self.0, idx, m);
+        let ff = s.splat_i(0xff);
+        (s.to_f32(w & ff), s.to_f32(s.shr(w, 8) & ff))
     }
 }
 
 /// Uniform lattice facts the sampler needs.
 #[derive(Clone, Copy)]
-struct Lattice<V> {
+pub(crate) struct Lattice<V> {
     vox: V,
     /// Largest grid coordinate per axis (`dims − 1`).
-    hi: [f32; 3],
+    pub(crate) hi: [f32; 3],
     /// Largest base index per axis (`dims − 2`).
     base_hi: [f32; 3],
     nx: i32,
@@ -135,10 +142,26 @@ struct Lattice<V> {
     scale: f32,
 }
 
+impl<V: Voxels> Lattice<V> {
+    /// The sampler's view of `grid` with voxels `vox` scaled by `scale` to density units.
+    #[inline(always)]
+    pub(crate) fn new(grid: &Grid, vox: V, scale: f32) -> Self {
+        let d = grid.dims;
+        Lattice {
+            vox,
+            hi: core::array::from_fn(|a| (d[a] - 1) as f32),
+            base_hi: core::array::from_fn(|a| (d[a] - 2) as f32),
+            nx: d[0] as i32,
+            nxy: (d[0] * d[1]) as i32,
+            scale,
+        }
+    }
+}
+
 /// Trilinear interpolation at grid coordinates `p` (clamped to the box), seven lerps
-/// (paper §4.4), eight gathers.
+/// (paper §4.4), four paired gathers.
 #[inline(always)]
-fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::F32 {
+pub(crate) fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::F32 {
     let zero = s.splat(0.0);
     let px = s.min(s.max(p.x, zero), s.splat(l.hi[0]));
     let py = s.min(s.max(p.y, zero), s.splat(l.hi[1]));
@@ -149,17 +172,12 @@ fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::
     let (fx, fy, fz) = (px - ix, py - iy, pz - iz);
     let nx = s.splat_i(l.nx);
     let nxy = s.splat_i(l.nxy);
-    let one = s.splat_i(1);
     let b = s.to_i32(ix) + s.mul_i(s.to_i32(iy), nx) + s.mul_i(s.to_i32(iz), nxy);
-    let v000 = l.vox.fetch(s, b, m);
-    let v100 = l.vox.fetch(s, b + one, m);
-    let v010 = l.vox.fetch(s, b + nx, m);
-    let v110 = l.vox.fetch(s, b + nx + one, m);
+    let (v000, v100) = l.vox.fetch2(s, b, m);
+    let (v010, v110) = l.vox.fetch2(s, b + nx, m);
     let b1 = b + nxy;
-    let v001 = l.vox.fetch(s, b1, m);
-    let v101 = l.vox.fetch(s, b1 + one, m);
-    let v011 = l.vox.fetch(s, b1 + nx, m);
-    let v111 = l.vox.fetch(s, b1 + nx + one, m);
+    let (v001, v101) = l.vox.fetch2(s, b1, m);
+    let (v011, v111) = l.vox.fetch2(s, b1 + nx, m);
     let lerp = |a: S::F32, b: S::F32, t: S::F32| a + (b - a) * t;
     let x00 = lerp(v000, v100, fx);
     let x10 = lerp(v010, v110, fx);
@@ -168,6 +186,20 @@ fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::
     let y0 = lerp(x00, x10, fy);
     let y1 = lerp(x01, x11, fy);
     lerp(y0, y1, fz) * s.splat(l.scale)
+}
+
+/// The binary16 value in bits 0-15 of each lane as f32 (sign ignored; no inf/NaN in the
+/// tables): exponent and mantissa moved into place, then rebiased by 2¹¹² (exact, subnormals
+/// included).
+#[inline(always)]
+fn half_lo<S: Simd>(s: S, w: S::I32) -> S::F32 {
+    s.bitcast_f(s.shl(w, 13) & s.splat_i(0x0fff_e000)) * s.splat(f32::from_bits(0x7780_0000))
+}
+
+/// As [`half_lo`] for bits 16-31.
+#[inline(always)]
+fn half_hi<S: Simd>(s: S, w: S::I32) -> S::F32 {
+    s.bitcast_f(s.shr(w, 3) & s.splat_i(0x0fff_e000)) * s.splat(f32::from_bits(0x7780_0000))
 }
 
 /// Transfer-function bin of a value: `round(clamp((v − lo)·to_bin, 0, 255))`, as
@@ -192,44 +224,15 @@ pub fn march<S: Simd>(
     active: S::M,
 ) -> [S::F32; 4] {
     let v = scene.volume;
-    let g = &v.grid;
-    let hi = core::array::from_fn(|a| (g.dims[a] - 1) as f32);
-    let base_hi = core::array::from_fn(|a| (g.dims[a] - 2) as f32);
-    let nx = g.dims[0] as i32;
-    let nxy = (g.dims[0] * g.dims[1]) as i32;
     match &v.data {
-        VolumeData::F32(d) => march_impl(
-            s,
-            scene,
-            &Lattice {
-                vox: F32Voxels(d),
-                hi,
-                base_hi,
-                nx,
-                nxy,
-                scale: 1.0,
-            },
-            orig,
-            dir,
-            tmax,
-            active,
-        ),
-        VolumeData::U8 { data, scale } => march_impl(
-            s,
-            scene,
-            &Lattice {
-                vox: U8Voxels(data),
-                hi,
-                base_hi,
-                nx,
-                nxy,
-                scale: *scale,
-            },
-            orig,
-            dir,
-            tmax,
-            active,
-        ),
+        VolumeData::F32(d) => {
+            let lat = Lattice::new(&v.grid, F32Voxels(d), 1.0);
+            march_impl(s, scene, &lat, orig, dir, tmax, active)
+        }
+        VolumeData::U8 { data, scale } => {
+            let lat = Lattice::new(&v.grid, U8Voxels(data), *scale);
+            march_impl(s, scene, &lat, orig, dir, tmax, active)
+        }
     }
 }
 
@@ -364,12 +367,7 @@ fn march_impl<S: Simd, V: Voxels>(
         _ => -dir.normalize(s),
     };
     let cutoff = s.splat(opts.opacity_cutoff);
-    let (table, preint) = if opts.preintegrated {
-        (&tf.preint[..], true)
-    } else {
-        (&tf.post[..], false)
-    };
-
+    let preint = opts.preintegrated;
     loop {
         // Phase 1: lanes that need a cell walk the DDA until a non-empty one (or the end).
         while use_cells && s.any(need) {
@@ -426,24 +424,34 @@ fn march_impl<S: Simd, V: Voxels>(
         }
         let tb = s.min(tk + dt, t_end);
         let frac = (tb - tk) / dt;
-        let bb_idx;
         let sb = trilinear(s, lat, og.mul_add(dg, tb), valid);
-        if preint {
+        let mut c = if preint {
             let front = valid & s.ne(prev_k, k);
             if s.any(front) {
                 let sf = trilinear(s, lat, og.mul_add(dg, tk), front);
                 s_prev = s.select(front, sf, s_prev);
             }
-            bb_idx = s.shl(s.shl(bin(s, tf, s_prev), 8) + bin(s, tf, sb), 2);
+            // binary16 table: 2 gathers from 512 KiB instead of 4 from 1 MiB; 1.13× on the
+            // frame above (9.73 → 8.62 s side by side under load).
+            let idx = s.shl(s.shl(bin(s, tf, s_prev), 8) + bin(s, tf, sb), 1);
+            let rg = s.gather_i(&tf.preint_half, idx, valid, s.splat_i(0));
+            let ba = s.gather_i(&tf.preint_half, idx + s.splat_i(1), valid, s.splat_i(0));
+            [
+                half_lo(s, rg),
+                half_hi(s, rg),
+                half_lo(s, ba),
+                half_hi(s, ba),
+            ]
         } else {
-            bb_idx = s.shl(bin(s, tf, sb), 2);
-        }
-        let mut c = [
-            s.gather(table, bb_idx, valid, zero),
-            s.gather(table, bb_idx + s.splat_i(1), valid, zero),
-            s.gather(table, bb_idx + s.splat_i(2), valid, zero),
-            s.gather(table, bb_idx + s.splat_i(3), valid, zero),
-        ];
+            let idx = s.shl(bin(s, tf, sb), 2);
+            let p = &tf.post;
+            [
+                s.gather(p, idx, valid, zero),
+                s.gather(p, idx + s.splat_i(1), valid, zero),
+                s.gather(p, idx + s.splat_i(2), valid, zero),
+                s.gather(p, idx + s.splat_i(3), valid, zero),
+            ]
+        };
         if lit {
             let shading = valid & s.gt(c[3], zero);
             if s.any(shading) {
@@ -570,9 +578,6 @@ impl Kernel for SampleBatch<'_, '_> {
     #[inline(always)]
     fn run<S: Simd>(self, s: S) {
         let g = &self.volume.grid;
-        let hi = core::array::from_fn(|a| (g.dims[a] - 1) as f32);
-        let base_hi = core::array::from_fn(|a| (g.dims[a] - 2) as f32);
-        let (nx, nxy) = (g.dims[0] as i32, (g.dims[0] * g.dims[1]) as i32);
         let inv_h = s.splat(1.0 / g.spacing);
         let n = self.out.len();
         let mut i = 0;
@@ -582,27 +587,9 @@ impl Kernel for SampleBatch<'_, '_> {
             let p = V3::<S>::new(ld(0), ld(1), ld(2));
             let m = s.first_n(n - i);
             let v = match &self.volume.data {
-                VolumeData::F32(d) => {
-                    let l = Lattice {
-                        vox: F32Voxels(d),
-                        hi,
-                        base_hi,
-                        nx,
-                        nxy,
-                        scale: 1.0,
-                    };
-                    trilinear(s, &l, p, m)
-                }
+                VolumeData::F32(d) => trilinear(s, &Lattice::new(g, F32Voxels(d), 1.0), p, m),
                 VolumeData::U8 { data, scale } => {
-                    let l = Lattice {
-                        vox: U8Voxels(data),
-                        hi,
-                        base_hi,
-                        nx,
-                        nxy,
-                        scale: *scale,
-                    };
-                    trilinear(s, &l, p, m)
+                    trilinear(s, &Lattice::new(g, U8Voxels(data), *scale), p, m)
                 }
             };
             s.store_masked(v, &mut self.out[i..], m);

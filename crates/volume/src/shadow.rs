@@ -13,8 +13,8 @@
 
 use spmd::{Simd, V3};
 
-use crate::grid::VolumeData;
-use crate::march::VolumeScene;
+use crate::grid::{Grid, VolumeData};
+use crate::march::{trilinear, F32Voxels, Lattice, U8Voxels, VolumeScene, Voxels};
 use crate::tf::{ClassifiedTf, TF_SIZE};
 
 /// Extinction per voxel of path for each transfer-function bin (for [`transmittance`]).
@@ -64,42 +64,22 @@ pub fn transmittance<S: Simd>(
     let v = scene.volume;
     match &v.data {
         VolumeData::F32(data) => {
-            march_tau(s, v, Vox::F(data), stf, o, d, tmax, active, step_voxels)
+            let lat = Lattice::new(&v.grid, F32Voxels(data), 1.0);
+            march_tau(s, &v.grid, &lat, stf, o, d, tmax, active, step_voxels)
         }
-        VolumeData::U8 { data, scale } => march_tau(
-            s,
-            v,
-            Vox::U(data, *scale),
-            stf,
-            o,
-            d,
-            tmax,
-            active,
-            step_voxels,
-        ),
-    }
-}
-
-#[derive(Clone, Copy)]
-enum Vox<'a> {
-    F(&'a [f32]),
-    U(&'a [u8], f32),
-}
-
-#[inline(always)]
-fn fetch<S: Simd>(s: S, v: Vox, idx: S::I32, m: S::M) -> S::F32 {
-    match v {
-        Vox::F(d) => s.gather(d, idx, m, s.splat(0.0)),
-        Vox::U(d, _) => s.to_f32(s.gather_u8(d, idx, m)),
+        VolumeData::U8 { data, scale } => {
+            let lat = Lattice::new(&v.grid, U8Voxels(data), *scale);
+            march_tau(s, &v.grid, &lat, stf, o, d, tmax, active, step_voxels)
+        }
     }
 }
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn march_tau<S: Simd>(
+fn march_tau<S: Simd, V: Voxels>(
     s: S,
-    v: &crate::grid::Volume,
-    vox: Vox,
+    g: &Grid,
+    lat: &Lattice<V>,
     stf: &ShadowTf,
     o: V3<S>,
     d: V3<S>,
@@ -107,7 +87,6 @@ fn march_tau<S: Simd>(
     active: S::M,
     step_voxels: f32,
 ) -> S::F32 {
-    let g = &v.grid;
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
     let inv_h = s.splat(1.0 / g.spacing);
@@ -117,11 +96,7 @@ fn march_tau<S: Simd>(
         (o.z - s.splat(g.origin[2])) * inv_h,
     );
     let dg = d.scale(inv_h);
-    let hi = [
-        (g.dims[0] - 1) as f32,
-        (g.dims[1] - 1) as f32,
-        (g.dims[2] - 1) as f32,
-    ];
+    let hi = lat.hi;
     let og_a = [og.x, og.y, og.z];
     let dg_a = [dg.x, dg.y, dg.z];
     let mut t_in = zero;
@@ -139,13 +114,6 @@ fn march_tau<S: Simd>(
     // Sum of τ·(fraction of a step): the last, partial step is weighted by its length.
     let mut sum = zero;
     let mut t = t_in;
-    let nx = s.splat_i(g.dims[0] as i32);
-    let nxy = s.splat_i((g.dims[0] * g.dims[1]) as i32);
-    let scale = match vox {
-        Vox::F(_) => 1.0,
-        Vox::U(_, k) => k,
-    };
-    let base_hi = [hi[0] - 1.0, hi[1] - 1.0, hi[2] - 1.0];
     // T < 1e-3 once Σ τ·Δ > ln 1000.
     let stop = s.splat(6.9 / step_voxels);
     let half = s.splat(0.5);
@@ -153,32 +121,7 @@ fn march_tau<S: Simd>(
         let tb = s.min(t + dt, t_end);
         let w = (tb - t) / dt;
         let p = og.mul_add(dg, (t + tb) * half);
-        // Trilinear interpolation (clamped to the box).
-        let px = s.min(s.max(p.x, zero), s.splat(hi[0]));
-        let py = s.min(s.max(p.y, zero), s.splat(hi[1]));
-        let pz = s.min(s.max(p.z, zero), s.splat(hi[2]));
-        let ix = s.min(s.floor(px), s.splat(base_hi[0]));
-        let iy = s.min(s.floor(py), s.splat(base_hi[1]));
-        let iz = s.min(s.floor(pz), s.splat(base_hi[2]));
-        let (fx, fy, fz) = (px - ix, py - iy, pz - iz);
-        let b = s.to_i32(ix) + s.mul_i(s.to_i32(iy), nx) + s.mul_i(s.to_i32(iz), nxy);
-        let i1 = s.splat_i(1);
-        let v000 = fetch(s, vox, b, alive);
-        let v100 = fetch(s, vox, b + i1, alive);
-        let v010 = fetch(s, vox, b + nx, alive);
-        let v110 = fetch(s, vox, b + nx + i1, alive);
-        let b1 = b + nxy;
-        let v001 = fetch(s, vox, b1, alive);
-        let v101 = fetch(s, vox, b1 + i1, alive);
-        let v011 = fetch(s, vox, b1 + nx, alive);
-        let v111 = fetch(s, vox, b1 + nx + i1, alive);
-        let x00 = lerp(s, v000, v100, fx);
-        let x10 = lerp(s, v010, v110, fx);
-        let x01 = lerp(s, v001, v101, fx);
-        let x11 = lerp(s, v011, v111, fx);
-        let y0 = lerp(s, x00, x10, fy);
-        let y1 = lerp(s, x01, x11, fy);
-        let val = lerp(s, y0, y1, fz) * s.splat(scale);
+        let val = trilinear(s, lat, p, alive);
         let x = (val - s.splat(stf.lo)) * s.splat(stf.to_bin);
         let x = s.min(s.max(x, zero), s.splat(255.0));
         let bin = s.to_i32(x + half);
@@ -189,10 +132,4 @@ fn march_tau<S: Simd>(
     }
     let tr = spmd::math::exp(s, -(sum * s.splat(step_voxels)));
     s.select(active, s.min(tr, one), one)
-}
-
-#[inline(always)]
-fn lerp<S: Simd>(s: S, a: S::F32, b: S::F32, t: S::F32) -> S::F32 {
-    let _ = s;
-    a + (b - a) * t
 }

@@ -3,7 +3,7 @@
 use core::arch::x86_64::*;
 
 use super::{assignops, binops, check_lanes};
-use crate::{Isa, Kernel, Simd};
+use crate::{le_bytes4, Isa, Kernel, Simd};
 
 /// Runs AVX2 and FMA intrinsics. SAFETY: only used on values of this file's types, whose existence
 /// proves AVX2 and FMA support (see the module docs of `x86`); memory accesses are bounds-checked
@@ -369,9 +369,9 @@ impl Simd for Avx2 {
         )))
     }
     #[inline(always)]
-    fn gather_u8(self, s: &[u8], idx: I32x8, m: M32x8) -> I32x8 {
-        // Fast path: gather 4 bytes at each active index and keep the low one, which needs
-        // `idx + 3 < len`; lanes near the end of `s` take the lane loop instead.
+    fn gather_u8x4(self, s: &[u8], idx: I32x8, m: M32x8) -> I32x8 {
+        // Fast path: one 4-byte gather per active lane, which needs `idx + 3 < len`; lanes
+        // near the end of `s` take the lane loop instead.
         if s.len() >= 4 && self.none(m & self.gt_i(idx, self.splat_i(clamp_len(s.len()) - 4))) {
             let m = active_in_bounds(self, idx, m, s.len(), 4);
             // Bounds: every active lane reads s[idx..idx + 4], inside `s` by the test above.
@@ -381,7 +381,7 @@ impl Simd for Avx2 {
                 idx.0,
                 _mm256_castps_si256(m.0)
             ));
-            return I32x8(w) & self.splat_i(0xff);
+            return I32x8(w);
         }
         let (mut iv, mut out) = ([0i32; 8], [0i32; 8]);
         self.store_i(idx, &mut iv);
@@ -389,7 +389,7 @@ impl Simd for Avx2 {
         check_lanes(&iv, bits, s.len());
         for l in 0..8 {
             if bits >> l & 1 != 0 {
-                out[l] = s[iv[l] as usize] as i32;
+                out[l] = le_bytes4(s, iv[l] as usize);
             }
         }
         self.load_i(&out)

@@ -4,7 +4,7 @@
 use core::arch::x86_64::*;
 
 use super::{assignops, binops, check_lanes};
-use crate::{Isa, Kernel, Simd};
+use crate::{le_bytes4, Isa, Kernel, Simd};
 
 /// Runs SSE4.1 intrinsics. SAFETY: only used on values of this file's types, whose existence
 /// proves SSE4.1 support (see the module docs of `x86`); memory accesses are bounds-checked
@@ -373,14 +373,14 @@ impl Simd for Sse41 {
         self.load_i(&out)
     }
     #[inline(always)]
-    fn gather_u8(self, s: &[u8], idx: I32x4, m: M32x4) -> I32x4 {
+    fn gather_u8x4(self, s: &[u8], idx: I32x4, m: M32x4) -> I32x4 {
         let (mut iv, mut out) = ([0i32; 4], [0i32; 4]);
         self.store_i(idx, &mut iv);
         let bits = self.bitmask(m);
         check_lanes(&iv, bits, s.len());
         for l in 0..4 {
             if bits >> l & 1 != 0 {
-                out[l] = s[iv[l] as usize] as i32;
+                out[l] = le_bytes4(s, iv[l] as usize);
             }
         }
         self.load_i(&out)

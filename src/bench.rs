@@ -13,16 +13,20 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use molecule::scenes::SceneName;
-use render::{render_frame_into, Camera, Framebuffer, RenderOptions, Scene, View};
+use render::{
+    render_frame_into, render_modal_into, Accum, Camera, Framebuffer, RenderOptions, Scene,
+    TraceOptions, View,
+};
 use serde_json::{json, Value};
 use spmd::Isa;
 use volume::{ClassifiedTf, Lighting, Macrocells, MarchOptions, Volume, VolumeScene};
 
 use crate::input::{BondSource, InputArgs};
 use crate::pipeline::{build_scene, build_volume, GeometryArgs, VolumeArgs};
-use crate::render_cmd::{load_tf, parse_size, ViewArg};
+use crate::render_cmd::{self, load_tf, parse_size, ViewArg};
 
-/// What a benchmark frame shows: the rows of the paper's Table 3 (and lit volume alone).
+/// What a benchmark frame shows: the rows of the paper's Table 3, lit volume alone, and the
+/// ray tracing modalities of §4.5 / Figure 4 (one sample per pixel per frame).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum BenchMode {
     /// Ball-and-stick, headlight diffuse shading ("b&s").
@@ -38,6 +42,18 @@ pub enum BenchMode {
     /// Volume alone with gradient lighting (not a row of Table 3).
     #[value(name = "volume-lit")]
     VolumeLit,
+    /// Ball-and-stick, diffuse light with hard shadows (`bnsview render --shadows`).
+    #[value(name = "bs-shadows")]
+    BsShadows,
+    /// Ball-and-stick, ambient occlusion with 1 ray per pixel (fps per AO sample; `--ao N`
+    /// costs about N times as much).
+    #[value(name = "bs-ao")]
+    BsAo,
+    /// Ball-and-stick path traced, metal BRDF, 1 sample per pixel (fps per spp).
+    Path,
+    /// vol+bs with hard shadows attenuated by the volume (`--volume-shadows`, §4.5).
+    #[value(name = "vol+bs-shadows")]
+    VolBsShadows,
 }
 
 impl BenchMode {
@@ -49,6 +65,26 @@ impl BenchMode {
         BenchMode::VolBsLit,
     ];
 
+    /// The default of `--quick`: the paper's four and the two cheap modalities (at 512² they
+    /// add ~10 s to a ~70 s quick run; path tracing and the lit volume would add ~3 minutes).
+    pub const QUICK: [BenchMode; 6] = [
+        BenchMode::Bs,
+        BenchMode::Volume,
+        BenchMode::VolBs,
+        BenchMode::VolBsLit,
+        BenchMode::BsShadows,
+        BenchMode::BsAo,
+    ];
+
+    /// The modalities issue 6 asks figures of (`--modes modalities`).
+    pub const MODALITIES: [BenchMode; 5] = [
+        BenchMode::BsShadows,
+        BenchMode::BsAo,
+        BenchMode::Path,
+        BenchMode::VolumeLit,
+        BenchMode::VolBsLit,
+    ];
+
     /// Name as on the command line and in the JSON.
     pub fn name(self) -> &'static str {
         match self {
@@ -57,13 +93,24 @@ impl BenchMode {
             BenchMode::VolBs => "vol+bs",
             BenchMode::VolBsLit => "vol+bs-lit",
             BenchMode::VolumeLit => "volume-lit",
+            BenchMode::BsShadows => "bs-shadows",
+            BenchMode::BsAo => "bs-ao",
+            BenchMode::Path => "path",
+            BenchMode::VolBsShadows => "vol+bs-shadows",
         }
     }
     fn geometry(self) -> bool {
-        matches!(self, BenchMode::Bs | BenchMode::VolBs | BenchMode::VolBsLit)
+        !matches!(self, BenchMode::Volume | BenchMode::VolumeLit)
     }
     fn volume(self) -> bool {
-        !matches!(self, BenchMode::Bs)
+        matches!(
+            self,
+            BenchMode::Volume
+                | BenchMode::VolBs
+                | BenchMode::VolBsLit
+                | BenchMode::VolumeLit
+                | BenchMode::VolBsShadows
+        )
     }
     fn lit(self) -> bool {
         matches!(self, BenchMode::VolBsLit | BenchMode::VolumeLit)
@@ -72,6 +119,77 @@ impl BenchMode {
     fn paper_row(self) -> Option<usize> {
         BenchMode::PAPER.iter().position(|&m| m == self)
     }
+    /// The `bnsview render` flags whose frame a modality mode times (`None`: the mode renders
+    /// through `render_frame_into`, as `bnsview render` does without modality flags). One
+    /// sample per pixel: `--ao 1`, `--spp 1`.
+    fn render_flags(self) -> Option<&'static [&'static str]> {
+        match self {
+            BenchMode::BsShadows => Some(&["--shadows"]),
+            BenchMode::BsAo => Some(&["--ao", "1"]),
+            BenchMode::Path => Some(&["--mode", "path", "--material", "metal", "--spp", "1"]),
+            BenchMode::VolBsShadows => Some(&["--mode", "vol+bs", "--shadows", "--volume-shadows"]),
+            _ => None,
+        }
+    }
+    /// Random samples per pixel of one frame (AO rays, paths), for the stochastic modes.
+    fn samples_per_pixel(self) -> Option<u32> {
+        match self {
+            BenchMode::BsAo | BenchMode::Path => Some(1),
+            _ => None,
+        }
+    }
+}
+
+/// An entry of `--modes`: a mode or a named set of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeSel {
+    One(BenchMode),
+    /// Every mode.
+    All,
+    /// [`BenchMode::MODALITIES`].
+    Modalities,
+}
+
+impl ValueEnum for ModeSel {
+    fn value_variants<'a>() -> &'a [Self] {
+        static V: std::sync::OnceLock<Vec<ModeSel>> = std::sync::OnceLock::new();
+        V.get_or_init(|| {
+            BenchMode::value_variants()
+                .iter()
+                .map(|&m| ModeSel::One(m))
+                .chain([ModeSel::All, ModeSel::Modalities])
+                .collect()
+        })
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        use clap::builder::PossibleValue;
+        match self {
+            ModeSel::One(m) => m.to_possible_value(),
+            ModeSel::All => Some(PossibleValue::new("all").help("Every mode above.")),
+            ModeSel::Modalities => Some(
+                PossibleValue::new("modalities")
+                    .help("bs-shadows, bs-ao, path, volume-lit, vol+bs-lit (issue 6)."),
+            ),
+        }
+    }
+}
+
+/// The modes of `--modes` in the order given, sets expanded, each once.
+fn expand_modes(sel: &[ModeSel]) -> Vec<BenchMode> {
+    let mut out: Vec<BenchMode> = Vec::new();
+    for s in sel {
+        let modes = match s {
+            ModeSel::One(m) => vec![*m],
+            ModeSel::All => BenchMode::value_variants().to_vec(),
+            ModeSel::Modalities => BenchMode::MODALITIES.to_vec(),
+        };
+        for m in modes {
+            if !out.contains(&m) {
+                out.push(m);
+            }
+        }
+    }
+    out
 }
 
 /// Which of the paper's tables to reproduce.
@@ -101,9 +219,12 @@ pub struct BenchArgs {
     /// or `--table 2` and no ns740k among the scenes they use the scenes given.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Option<Vec<SceneName>>,
-    /// Modes of Table 3 (comma separated; default bs,volume,vol+bs,vol+bs-lit).
+    /// Modes of Table 3 (comma separated; default bs,volume,vol+bs,vol+bs-lit, with --quick
+    /// also bs-shadows,bs-ao). `all` is every mode, `modalities` is
+    /// bs-shadows,bs-ao,path,volume-lit,vol+bs-lit. The modalities render one sample per pixel
+    /// per frame, as `bnsview render` with the default light, AO distance and material.
     #[arg(long, value_enum, value_delimiter = ',')]
-    pub modes: Option<Vec<BenchMode>>,
+    pub modes: Option<Vec<ModeSel>>,
     /// Views of Table 3 (comma separated; default far,close).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub views: Option<Vec<ViewArg>>,
@@ -126,7 +247,8 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 1)]
     pub warmup: usize,
     /// Small scenes (nanobowl and ns90k full, the others 100K atoms), 512² frames (Table 1:
-    /// 256² and 512²), 3 frames after the warm-up: a run of a few minutes.
+    /// 256² and 512²), 3 frames after the warm-up, the paper's modes and bs-shadows, bs-ao: a
+    /// run of a few minutes (`--quick --modes all` adds path tracing and the other modes).
     #[arg(long)]
     pub quick: bool,
     /// Atoms per scene (overrides the paper's count and --quick).
@@ -216,6 +338,26 @@ const PAPER_TABLE1: [(f64, f64); 5] = [
 /// Table 2, row "bnsView": ns740k far, volume, 1024², fps by number of cores.
 const PAPER_TABLE2: [(u32, f64); 5] = [(1, 0.394), (2, 0.779), (4, 1.54), (8, 3.05), (16, 5.93)];
 
+/// The paper's Figure 4 caption (§4.5), whole: "Ray tracing modalities with bnsView. From left
+/// to right: ball-and-stick with diffuse illumination and shadows (58 fps on the Xeon Phi),
+/// ambient occlusion (1.8 fps), and path traced with a metal BRDF (0.25 fps); unlit volume
+/// rendering with volumetric shadows (16 fps), and the same with gradient lighting (3.7 fps)."
+/// Measured on the Xeon Phi SE10P (61 cores), not the Table 1-3 CPU; no scene, view, frame
+/// size, AO sample count or spp is given. Each figure with the caption's words and our mode of
+/// the same modality; the two volume pictures have no such mode (shadows cast by the volume
+/// onto itself: `bnsview render --mode volume --volume-shadows` is not available).
+const PAPER_FIGURE4: [(&str, f64, Option<BenchMode>); 5] = [
+    (
+        "ball-and-stick with diffuse illumination and shadows",
+        58.0,
+        Some(BenchMode::BsShadows),
+    ),
+    ("ambient occlusion", 1.8, Some(BenchMode::BsAo)),
+    ("path traced with a metal BRDF", 0.25, Some(BenchMode::Path)),
+    ("unlit volume rendering with volumetric shadows", 16.0, None),
+    ("the same with gradient lighting", 3.7, None),
+];
+
 /// Density resolution the paper used (Table 3).
 fn paper_voxels_per_angstrom(scene: SceneName) -> f32 {
     paper_preprocess(scene)[3] as f32
@@ -276,7 +418,11 @@ fn plan(a: &BenchArgs, nproc: u32) -> Vec<(Key, u8)> {
         .size
         .unwrap_or(if a.quick { (512, 512) } else { (1024, 1024) });
     if want(TableSel::T3) {
-        let modes = a.modes.clone().unwrap_or_else(|| BenchMode::PAPER.to_vec());
+        let modes = match &a.modes {
+            Some(sel) => expand_modes(sel),
+            None if a.quick => BenchMode::QUICK.to_vec(),
+            None => BenchMode::PAPER.to_vec(),
+        };
         let views = a
             .views
             .clone()
@@ -410,6 +556,7 @@ impl Measurement {
             "scene": self.key.scene.to_string(),
             "atoms": self.atoms,
             "mode": self.key.mode.name(),
+            "samples_per_pixel": self.key.mode.samples_per_pixel(),
             "view": self.key.view(),
             "width": self.key.w,
             "height": self.key.h,
@@ -1020,10 +1167,8 @@ fn bench_scene(
         Some(s) => (s.center, s.radius),
         None => atoms_sphere(m, &a.geometry),
     };
-    let opt = RenderOptions::default();
     let mut out = Vec::new();
     for &(key, tables) in keys {
-        let mut fb = Framebuffer::new(key.w, key.h, opt.background)?;
         let camera = camera_for(sphere, key.far, key.w, key.h);
         let geo = if key.mode.geometry() {
             scene_bvh.as_ref()
@@ -1035,6 +1180,7 @@ fn bench_scene(
             (true, false) => unlit.as_ref(),
             (true, true) => lit.as_ref(),
         };
+        let mut renderer = Renderer::new(&key, geo, vs)?;
         let pool = match pools.entry(key.threads) {
             std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::btree_map::Entry::Vacant(e) => e.insert(
@@ -1047,14 +1193,10 @@ fn bench_scene(
         for &isa in isas {
             let ms = pool.install(|| {
                 for _ in 0..a.warmup {
-                    render_frame_into(geo, vs, &camera, &mut fb, &opt, isa);
+                    renderer.frame(&camera, isa);
                 }
                 (0..frames)
-                    .map(|_| {
-                        let t = Instant::now();
-                        render_frame_into(geo, vs, &camera, &mut fb, &opt, isa);
-                        t.elapsed().as_secs_f64() * 1e3
-                    })
+                    .map(|_| renderer.frame(&camera, isa))
                     .collect::<Vec<f64>>()
             });
             let load1 = load_avg()[0];
@@ -1089,6 +1231,76 @@ fn bench_scene(
     Ok((p, out))
 }
 
+/// Renders a mode's frame, again and again.
+enum Renderer<'a> {
+    /// `render_frame_into`: headlight b&s, volume, vol+b&s (as `bnsview render` without
+    /// modality flags).
+    Frame {
+        geo: Option<&'a Scene>,
+        vol: Option<&'a VolumeScene<'a>>,
+        fb: Framebuffer,
+        opt: RenderOptions,
+    },
+    /// `render_modal_into` with the trace options of the mode's `bnsview render` flags.
+    Modal {
+        scene: &'a Scene,
+        vol: Option<&'a VolumeScene<'a>>,
+        acc: Accum,
+        opt: TraceOptions,
+        spp: u32,
+    },
+}
+
+impl<'a> Renderer<'a> {
+    fn new(
+        key: &Key,
+        geo: Option<&'a Scene>,
+        vol: Option<&'a VolumeScene<'a>>,
+    ) -> Result<Renderer<'a>> {
+        let Some(flags) = key.mode.render_flags() else {
+            let opt = RenderOptions::default();
+            let fb = Framebuffer::new(key.w, key.h, opt.background)?;
+            return Ok(Renderer::Frame { geo, vol, fb, opt });
+        };
+        let args = render_cmd::parse_render_flags(flags)?;
+        render_cmd::check_modalities(&args)?;
+        let modality = render_cmd::modality(&args)
+            .with_context(|| format!("render flags {flags:?} select no modality"))?;
+        Ok(Renderer::Modal {
+            scene: geo.context("a modality mode without ball-and-stick geometry")?,
+            vol,
+            acc: Accum::new(key.w, key.h)?,
+            opt: render_cmd::trace_options(&args, modality),
+            spp: render_cmd::samples_per_pixel(&args),
+        })
+    }
+
+    /// Renders one complete frame and returns its time in ms. A modality starts from an empty
+    /// accumulation every frame (sample numbers from 0, so every frame does the same work).
+    fn frame(&mut self, camera: &Camera, isa: Isa) -> f64 {
+        match self {
+            Renderer::Frame { geo, vol, fb, opt } => {
+                let t = Instant::now();
+                render_frame_into(*geo, *vol, camera, fb, opt, isa);
+                t.elapsed().as_secs_f64() * 1e3
+            }
+            Renderer::Modal {
+                scene,
+                vol,
+                acc,
+                opt,
+                spp,
+            } => {
+                acc.rgb.fill(0.0);
+                acc.samples = 0;
+                let t = Instant::now();
+                render_modal_into(scene, *vol, camera, acc, opt, *spp, isa);
+                t.elapsed().as_secs_f64() * 1e3
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Report.
 
@@ -1108,6 +1320,74 @@ fn f2(x: f64) -> String {
 
 fn opt_f(x: Option<f64>) -> String {
     x.map(f2).unwrap_or_else(|| "-".into())
+}
+
+/// `a / b`, a dash for a missing figure.
+fn pair(a: Option<f64>, b: Option<f64>) -> String {
+    format!("{} / {}", opt_f(a), opt_f(b))
+}
+
+/// The far and close measurements of a scene and mode among `sel` (one ISA, size, threads).
+fn far_close<'a>(
+    sel: &[&'a Measurement],
+    scene: SceneName,
+    mode: BenchMode,
+) -> [Option<&'a Measurement>; 2] {
+    [true, false].map(|far| {
+        sel.iter()
+            .find(|m| m.key.scene == scene && m.key.mode == mode && m.key.far == far)
+            .copied()
+    })
+}
+
+/// The paper's Figure 4 beside our modality modes, one column per scene, for the
+/// measurements `sel` of one ISA, size and thread count; nothing if none is a modality.
+fn figure4_table(o: &mut String, sel: &[&Measurement]) {
+    use std::fmt::Write as _;
+    let Some(k) = sel
+        .iter()
+        .find(|m| m.key.mode.render_flags().is_some())
+        .map(|m| (m.key, m.isa))
+    else {
+        return;
+    };
+    let scenes: BTreeSet<usize> = sel.iter().map(|m| sidx(m.key.scene)).collect();
+    let _ = writeln!(
+        o,
+        "### The paper's Figure 4 (ray tracing modalities) beside ours, fps far / close, {}x{}, \
+         {}, {} thread{}\n\n\
+         Paper: Xeon Phi SE10P (61 cores, 1.1 GHz), not the CPU of Tables 1-3; its caption names \
+         no scene, view, frame size, AO sample count or samples per pixel. Ours: one sample per \
+         pixel per frame (bs-ao: 1 AO ray, path: 1 path); `--ao N` and `--spp N` cost about N \
+         times as much.\n",
+        k.0.w,
+        k.0.h,
+        k.1,
+        k.0.threads,
+        if k.0.threads == 1 { "" } else { "s" }
+    );
+    let mut head = String::from("| paper (Figure 4) | paper fps | ours |");
+    let mut rule = String::from("|---|---|---|");
+    for &si in &scenes {
+        let _ = write!(head, " {} |", SceneName::ALL[si]);
+        rule.push_str("---|");
+    }
+    let _ = writeln!(o, "{head}\n{rule}");
+    for (what, fps, mode) in PAPER_FIGURE4 {
+        let mut line = format!(
+            "| {what} | {} | {} |",
+            f2(fps),
+            mode.map_or("-", BenchMode::name)
+        );
+        for &si in &scenes {
+            let ours = mode
+                .map(|m| far_close(sel, SceneName::ALL[si], m).map(|x| x.map(Measurement::fps)));
+            let [f, c] = ours.unwrap_or([None, None]);
+            let _ = write!(line, " {} |", pair(f, c));
+        }
+        let _ = writeln!(o, "{line}");
+    }
+    let _ = writeln!(o);
 }
 
 fn report(
@@ -1205,26 +1485,21 @@ fn report(
             "| scene | atoms | mode | ours fps | paper fps (16 cores) | ours per core | paper per core | per-core ratio |"
         );
         let _ = writeln!(o, "|---|---|---|---|---|---|---|---|");
-        let rows: BTreeSet<(usize, BenchMode)> = t3
+        let sel: Vec<&Measurement> = t3
             .iter()
             .filter(|m| (m.isa, m.key.w, m.key.h, m.key.threads) == (isa, w, h, threads))
+            .copied()
+            .collect();
+        let rows: BTreeSet<(usize, BenchMode)> = sel
+            .iter()
             .map(|m| (sidx(m.key.scene), m.key.mode))
             .collect();
         for (si, mode) in rows {
             let scene = SceneName::ALL[si];
-            let get = |far: bool| {
-                t3.iter().find(|m| {
-                    m.key.scene == scene
-                        && m.key.mode == mode
-                        && m.key.far == far
-                        && (m.isa, m.key.w, m.key.h, m.key.threads) == (isa, w, h, threads)
-                })
-            };
-            let (f, c) = (get(true), get(false));
+            let [f, c] = far_close(&sel, scene, mode);
             let atoms = f.or(c).map(|m| m.atoms).unwrap_or(0);
             let ours = [f.map(|m| m.fps()), c.map(|m| m.fps())];
             let paper = mode.paper_row().map(|r| paper_table3(scene)[r]);
-            let pair = |a: Option<f64>, b: Option<f64>| format!("{} / {}", opt_f(a), opt_f(b));
             let per_core = |x: Option<f64>| x.map(|v| v * scale / threads as f64);
             let paper_core = |i: usize| paper.map(|p| p[i] / PAPER_CORES);
             let ratio = |i: usize| match (per_core(ours[i]), paper_core(i)) {
@@ -1247,6 +1522,7 @@ fn report(
             );
         }
         let _ = writeln!(o);
+        figure4_table(o, &sel);
     }
 
     // Table 1: frame-buffer size.
@@ -1522,6 +1798,118 @@ mod tests {
             (r - scene.radius).abs() < 1e-3 * scene.radius,
             "{r} {}",
             scene.radius
+        );
+    }
+
+    #[test]
+    fn mode_sets_expand_in_order_each_once() {
+        let modes = |a: &[&str]| {
+            let mut v = vec!["--scenes", "nanobowl", "--views", "far", "--modes"];
+            v.extend_from_slice(a);
+            plan(&args(&v), 2)
+                .iter()
+                .map(|(k, _)| k.mode.name())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            modes(&["modalities"]),
+            ["bs-shadows", "bs-ao", "path", "volume-lit", "vol+bs-lit"]
+        );
+        assert_eq!(
+            modes(&["path,modalities,bs"]),
+            [
+                "path",
+                "bs-shadows",
+                "bs-ao",
+                "volume-lit",
+                "vol+bs-lit",
+                "bs"
+            ]
+        );
+        let all = modes(&["all"]);
+        assert_eq!(all.len(), BenchMode::value_variants().len());
+        for m in BenchMode::value_variants() {
+            assert!(all.contains(&m.name()), "{m:?}");
+            // The JSON name reads back as the same mode.
+            assert_eq!(BenchMode::from_str(m.name(), true), Ok(*m));
+        }
+        // The default stays the paper's four; --quick adds the two cheap modalities.
+        let default = |extra: &[&str]| {
+            let mut v = vec!["--scenes", "nanobowl", "--views", "far", "--table", "3"];
+            v.extend_from_slice(extra);
+            plan(&args(&v), 2)
+                .iter()
+                .map(|(k, _)| k.mode)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(default(&[]), BenchMode::PAPER);
+        assert_eq!(default(&["--quick"]), BenchMode::QUICK);
+        assert_eq!(default(&["--quick", "--modes", "path"]), [BenchMode::Path]);
+    }
+
+    #[test]
+    fn an_unknown_mode_is_refused_with_the_choices() {
+        use clap::Parser;
+        #[derive(Parser, Debug)]
+        struct P {
+            #[command(flatten)]
+            b: BenchArgs,
+        }
+        let e = P::try_parse_from(["bench", "--modes", "bs,shadows"]).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("shadows"), "{msg}");
+        for name in ["bs-shadows", "path", "all", "modalities"] {
+            assert!(msg.contains(name), "{msg}");
+        }
+    }
+
+    #[test]
+    fn modality_modes_are_the_render_commands_with_one_sample() {
+        use render::{Material, Modality};
+        let opts = |m: BenchMode| {
+            let a = render_cmd::parse_render_flags(m.render_flags().unwrap()).unwrap();
+            render_cmd::check_modalities(&a).unwrap();
+            let modality = render_cmd::modality(&a).unwrap();
+            (
+                render_cmd::trace_options(&a, modality),
+                render_cmd::samples_per_pixel(&a),
+            )
+        };
+        let (o, spp) = opts(BenchMode::BsShadows);
+        assert_eq!(o.modality, Modality::Direct { shadows: true });
+        assert!(!o.volume_shadows);
+        assert_eq!(spp, 1);
+        let (o, spp) = opts(BenchMode::BsAo);
+        assert!(
+            matches!(o.modality, Modality::Ao { samples: 1, distance } if distance > 0.0),
+            "{o:?}"
+        );
+        assert_eq!(Some(spp), BenchMode::BsAo.samples_per_pixel());
+        let (o, spp) = opts(BenchMode::Path);
+        assert!(
+            matches!(
+                o.modality,
+                Modality::Path {
+                    material: Material::Metal,
+                    ..
+                }
+            ),
+            "{o:?}"
+        );
+        assert_eq!(Some(spp), BenchMode::Path.samples_per_pixel());
+        let (o, _) = opts(BenchMode::VolBsShadows);
+        assert_eq!(o.modality, Modality::Direct { shadows: true });
+        assert!(o.volume_shadows);
+        assert!(BenchMode::VolBsShadows.volume() && !BenchMode::VolBsShadows.lit());
+        for m in [BenchMode::BsShadows, BenchMode::BsAo, BenchMode::Path] {
+            assert!(m.geometry() && !m.volume(), "{m:?}");
+        }
+        // The same seed, light and defaults as `bnsview render` with no flags.
+        let plain = render_cmd::parse_render_flags(&[]).unwrap();
+        let shadows = opts(BenchMode::BsShadows).0;
+        assert_eq!(
+            shadows,
+            render_cmd::trace_options(&plain, Modality::Direct { shadows: true })
         );
     }
 

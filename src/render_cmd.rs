@@ -415,11 +415,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         )),
         _ => None,
     };
-    let [r, g, b] = args.background.unwrap_or(if args.mode == Mode::Bs {
-        [255, 255, 255]
-    } else {
-        [12, 12, 20]
-    });
+    let [r, g, b] = background(&args);
     let opt = RenderOptions {
         background: render::rgba(r, g, b, 255),
         ..RenderOptions::default()
@@ -427,23 +423,9 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     let t = Instant::now();
     let fb = match (modality(&args), &scene) {
         (Some(modality), Some(scene)) => {
-            let topt = TraceOptions {
-                modality,
-                light_dir: args.light_dir.unwrap_or(TraceOptions::default().light_dir),
-                light_intensity: args.light_intensity,
-                ambient: args.ambient,
-                background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
-                seed: args.sample_seed,
-                volume_shadows: args.volume_shadows,
-                shadow_step_voxels: args.shadow_step,
-                exposure: args.exposure,
-                secondary: match args.secondary {
-                    SecondaryArg::Packet => SecondaryTraversal::Packet,
-                    SecondaryArg::Single => SecondaryTraversal::Single,
-                },
-            };
+            let topt = trace_options(&args, modality);
             let path = args.mode == Mode::Path;
-            let spp = if path { args.spp } else { 1 };
+            let spp = samples_per_pixel(&args);
             let mut acc = Accum::new(w, h)?;
             let stats =
                 render_modal_into(scene, vscene.as_ref(), &camera, &mut acc, &topt, spp, isa);
@@ -490,8 +472,62 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     Ok(())
 }
 
+/// The `RenderArgs` of `bnsview render FLAGS` (clap's defaults for every flag not given), so
+/// that other commands (`bnsview bench`) render exactly what `render` would.
+pub(crate) fn parse_render_flags(flags: &[&str]) -> Result<RenderArgs> {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Render {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+    let argv = std::iter::once("render").chain(flags.iter().copied());
+    Render::try_parse_from(argv)
+        .map(|r| r.args)
+        .with_context(|| format!("parsing the render flags {}", flags.join(" ")))
+}
+
+/// Background colour: `--background`, else white for `bs` and near-black for the others.
+fn background(args: &RenderArgs) -> [u8; 3] {
+    args.background.unwrap_or(if args.mode == Mode::Bs {
+        [255, 255, 255]
+    } else {
+        [12, 12, 20]
+    })
+}
+
+/// Samples per pixel of a modality render: `--spp` for path tracing, else 1 (Direct and AO
+/// trace the pixel centre, so more samples would only repeat it).
+pub(crate) fn samples_per_pixel(args: &RenderArgs) -> u32 {
+    if args.mode == Mode::Path {
+        args.spp
+    } else {
+        1
+    }
+}
+
+/// Options of the ray tracing modalities from the flags.
+pub(crate) fn trace_options(args: &RenderArgs, modality: Modality) -> TraceOptions {
+    let [r, g, b] = background(args);
+    TraceOptions {
+        modality,
+        light_dir: args.light_dir.unwrap_or(TraceOptions::default().light_dir),
+        light_intensity: args.light_intensity,
+        ambient: args.ambient,
+        background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
+        seed: args.sample_seed,
+        volume_shadows: args.volume_shadows,
+        shadow_step_voxels: args.shadow_step,
+        exposure: args.exposure,
+        secondary: match args.secondary {
+            SecondaryArg::Packet => SecondaryTraversal::Packet,
+            SecondaryArg::Single => SecondaryTraversal::Single,
+        },
+    }
+}
+
 /// Rejects combinations of modality flags that do nothing, with what to use instead.
-fn check_modalities(args: &RenderArgs) -> Result<()> {
+pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
     let m = args.mode;
     if args.lit && matches!(m, Mode::Bs | Mode::Path) {
         bail!("--lit lights the volume: use it with --mode volume or --mode vol+bs");
@@ -545,7 +581,7 @@ fn check_modalities(args: &RenderArgs) -> Result<()> {
 }
 
 /// The ray tracing modality the flags ask for (`None`: the plain headlight / volume modes).
-fn modality(args: &RenderArgs) -> Option<Modality> {
+pub(crate) fn modality(args: &RenderArgs) -> Option<Modality> {
     if args.mode == Mode::Path {
         return Some(Modality::Path {
             material: match args.material {

@@ -19,6 +19,14 @@ fn tmp(name: &str) -> PathBuf {
     p
 }
 
+/// `bnsview bench --scenes nanobowl --atoms ATOMS --frames FRAMES`.
+fn nanobowl_bench(atoms: &str, frames: &str) -> Command {
+    let mut c = bnsview();
+    c.args(["bench", "--scenes", "nanobowl", "--atoms", atoms])
+        .args(["--frames", frames]);
+    c
+}
+
 fn run_ok(c: &mut Command) -> (String, String) {
     let out = c.output().expect("run bnsview");
     let (so, se) = (
@@ -84,21 +92,8 @@ fn check_frame(r: &Value) {
 fn tiny_table3_run_writes_a_record_per_measurement() {
     let json = tmp("t3");
     let (stdout, _) = run_ok(
-        bnsview()
-            .args([
-                "bench",
-                "--scenes",
-                "nanobowl",
-                "--atoms",
-                "2000",
-                "--frames",
-                "2",
-                "--size",
-                "64x64",
-                "--threads",
-                "1",
-                "--json",
-            ])
+        nanobowl_bench("2000", "2")
+            .args(["--size", "64x64", "--threads", "1", "--json"])
             .arg(&json),
     );
     let recs = records(&json);
@@ -251,6 +246,70 @@ fn every_isa_and_tables_one_and_two() {
         .collect();
     assert_eq!(threads, (1..=nproc).collect::<Vec<_>>());
     assert!(stdout.contains("Table 2"), "{stdout}");
+    let _ = std::fs::remove_file(&json);
+}
+
+#[test]
+fn modality_modes_write_records_and_the_figure_4_table() {
+    let json = tmp("modal");
+    let modes = ["bs-shadows", "bs-ao", "path", "vol+bs-shadows"];
+    let (stdout, _) = run_ok(
+        nanobowl_bench("1000", "2")
+            .args([
+                "--size",
+                "48x32",
+                "--threads",
+                "1",
+                "--views",
+                "far",
+                "--modes",
+            ])
+            .arg(modes.join(","))
+            .arg("--json")
+            .arg(&json),
+    );
+    let frames: Vec<Value> = records(&json)
+        .into_iter()
+        .filter(|r| r["kind"] == "frame")
+        .collect();
+    let seen: Vec<&str> = frames.iter().map(|r| r["mode"].as_str().unwrap()).collect();
+    assert_eq!(seen, modes, "{frames:?}");
+    for r in &frames {
+        check_frame(r);
+        assert!(r["fps_median"].as_f64().unwrap() > 0.0, "{r}");
+        assert_eq!(r["frames"].as_u64(), Some(2));
+        assert_eq!(
+            (r["width"].as_u64(), r["height"].as_u64()),
+            (Some(48), Some(32))
+        );
+        // AO and path tracing time one sample per pixel per frame.
+        let spp = r["samples_per_pixel"].as_u64();
+        match r["mode"].as_str().unwrap() {
+            "bs-ao" | "path" => assert_eq!(spp, Some(1), "{r}"),
+            _ => assert!(r["samples_per_pixel"].is_null(), "{r}"),
+        }
+    }
+    // Table 3 has a row per mode (no paper figure); the paper's Figure 4 is printed beside ours.
+    for m in modes {
+        let row = stdout
+            .lines()
+            .find(|l| l.starts_with("| nanobowl | ") && l.contains(&format!(" | {m} | ")));
+        let cells: Vec<&str> = row.expect(m).split('|').map(str::trim).collect();
+        assert_eq!(cells[5], "- / -", "{m}: no paper figure in Table 3");
+    }
+    assert!(stdout.contains("Figure 4"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "| ball-and-stick with diffuse illumination and shadows | 58.0 | bs-shadows |"
+        ),
+        "{stdout}"
+    );
+    // --report reads the new modes back.
+    let (again, _) = run_ok(bnsview().args(["bench", "--report"]).arg(&json));
+    assert!(
+        again.contains("| path traced with a metal BRDF | 0.250 | path |"),
+        "{again}"
+    );
     let _ = std::fs::remove_file(&json);
 }
 

@@ -19,7 +19,7 @@ use render::{
 };
 use serde_json::{json, Value};
 use spmd::Isa;
-use volume::{ClassifiedTf, Lighting, Macrocells, MarchOptions, Volume, VolumeScene};
+use volume::{ClassifiedTf, Macrocells, MarchOptions, Volume, VolumeScene};
 
 use crate::input::{BondSource, InputArgs};
 use crate::pipeline::{build_scene, build_volume, GeometryArgs, VolumeArgs};
@@ -51,9 +51,16 @@ pub enum BenchMode {
     BsAo,
     /// Ball-and-stick path traced, metal BRDF, 1 sample per pixel (fps per spp).
     Path,
-    /// vol+bs with hard shadows attenuated by the volume (`--volume-shadows`, §4.5).
+    /// vol+bs with hard shadows attenuated by the volume, which also shadows itself
+    /// (`--volume-shadows`, §4.5).
     #[value(name = "vol+bs-shadows")]
     VolBsShadows,
+    /// Unlit volume alone with volumetric shadows (Figure 4, fourth picture).
+    #[value(name = "volume-shadows")]
+    VolumeShadows,
+    /// Gradient-lit volume alone with volumetric shadows (Figure 4, fifth picture).
+    #[value(name = "volume-lit-shadows")]
+    VolumeLitShadows,
 }
 
 impl BenchMode {
@@ -77,12 +84,14 @@ impl BenchMode {
     ];
 
     /// The modalities issue 6 asks figures of (`--modes modalities`).
-    pub const MODALITIES: [BenchMode; 5] = [
+    pub const MODALITIES: [BenchMode; 7] = [
         BenchMode::BsShadows,
         BenchMode::BsAo,
         BenchMode::Path,
         BenchMode::VolumeLit,
         BenchMode::VolBsLit,
+        BenchMode::VolumeShadows,
+        BenchMode::VolumeLitShadows,
     ];
 
     /// Name as on the command line and in the JSON.
@@ -97,10 +106,18 @@ impl BenchMode {
             BenchMode::BsAo => "bs-ao",
             BenchMode::Path => "path",
             BenchMode::VolBsShadows => "vol+bs-shadows",
+            BenchMode::VolumeShadows => "volume-shadows",
+            BenchMode::VolumeLitShadows => "volume-lit-shadows",
         }
     }
     fn geometry(self) -> bool {
-        !matches!(self, BenchMode::Volume | BenchMode::VolumeLit)
+        !matches!(
+            self,
+            BenchMode::Volume
+                | BenchMode::VolumeLit
+                | BenchMode::VolumeShadows
+                | BenchMode::VolumeLitShadows
+        )
     }
     fn volume(self) -> bool {
         matches!(
@@ -110,10 +127,21 @@ impl BenchMode {
                 | BenchMode::VolBsLit
                 | BenchMode::VolumeLit
                 | BenchMode::VolBsShadows
+                | BenchMode::VolumeShadows
+                | BenchMode::VolumeLitShadows
         )
     }
-    fn lit(self) -> bool {
-        matches!(self, BenchMode::VolBsLit | BenchMode::VolumeLit)
+    /// The `bnsview render` flags that set the volume's marcher options (lighting and
+    /// volumetric shadows) for the volume modes.
+    fn volume_flags(self) -> &'static [&'static str] {
+        match self {
+            BenchMode::VolBsLit => &["--mode", "vol+bs", "--lit"],
+            BenchMode::VolumeLit => &["--mode", "volume", "--lit"],
+            BenchMode::VolBsShadows => &["--mode", "vol+bs", "--shadows", "--volume-shadows"],
+            BenchMode::VolumeShadows => &["--mode", "volume", "--volume-shadows"],
+            BenchMode::VolumeLitShadows => &["--mode", "volume", "--lit", "--volume-shadows"],
+            _ => &[],
+        }
     }
     /// Row of the paper's Table 3 (CPU), if this mode is one.
     fn paper_row(self) -> Option<usize> {
@@ -166,10 +194,10 @@ impl ValueEnum for ModeSel {
         match self {
             ModeSel::One(m) => m.to_possible_value(),
             ModeSel::All => Some(PossibleValue::new("all").help("Every mode above.")),
-            ModeSel::Modalities => Some(
-                PossibleValue::new("modalities")
-                    .help("bs-shadows, bs-ao, path, volume-lit, vol+bs-lit (issue 6)."),
-            ),
+            ModeSel::Modalities => Some(PossibleValue::new("modalities").help(
+                "bs-shadows, bs-ao, path, volume-lit, vol+bs-lit, volume-shadows, \
+                         volume-lit-shadows (issue 6).",
+            )),
         }
     }
 }
@@ -344,8 +372,7 @@ const PAPER_TABLE2: [(u32, f64); 5] = [(1, 0.394), (2, 0.779), (4, 1.54), (8, 3.
 /// rendering with volumetric shadows (16 fps), and the same with gradient lighting (3.7 fps)."
 /// Measured on the Xeon Phi SE10P (61 cores), not the Table 1-3 CPU; no scene, view, frame
 /// size, AO sample count or spp is given. Each figure with the caption's words and our mode of
-/// the same modality; the two volume pictures have no such mode (shadows cast by the volume
-/// onto itself: `bnsview render --mode volume --volume-shadows` is not available).
+/// the same modality.
 const PAPER_FIGURE4: [(&str, f64, Option<BenchMode>); 5] = [
     (
         "ball-and-stick with diffuse illumination and shadows",
@@ -354,8 +381,16 @@ const PAPER_FIGURE4: [(&str, f64, Option<BenchMode>); 5] = [
     ),
     ("ambient occlusion", 1.8, Some(BenchMode::BsAo)),
     ("path traced with a metal BRDF", 0.25, Some(BenchMode::Path)),
-    ("unlit volume rendering with volumetric shadows", 16.0, None),
-    ("the same with gradient lighting", 3.7, None),
+    (
+        "unlit volume rendering with volumetric shadows",
+        16.0,
+        Some(BenchMode::VolumeShadows),
+    ),
+    (
+        "the same with gradient lighting",
+        3.7,
+        Some(BenchMode::VolumeLitShadows),
+    ),
 ];
 
 /// Density resolution the paper used (Table 3).
@@ -1143,26 +1178,20 @@ fn bench_scene(
     let ctf = vol
         .as_ref()
         .map(|(v, _, _)| ClassifiedTf::new(tf, 0.0, v.max_value, 0.5));
-    let vscene = |lit: bool| -> Option<VolumeScene<'_>> {
-        match (&vol, &ctf) {
-            (Some((v, cells, _)), Some(ctf)) => Some(VolumeScene::new(
-                v,
-                cells,
-                ctf,
-                MarchOptions {
+    // The marcher's options of a mode, from the same flags as `bnsview render`.
+    let vscene = |mode: BenchMode| -> Result<Option<VolumeScene<'_>>> {
+        Ok(match (&vol, &ctf, mode.volume()) {
+            (Some((v, cells, _)), Some(ctf), true) => {
+                let args = render_cmd::parse_render_flags(mode.volume_flags())?;
+                let opts = MarchOptions {
                     macrocells: !a.no_macrocells,
-                    lighting: if lit {
-                        Lighting::Headlight
-                    } else {
-                        Lighting::Unlit
-                    },
-                    ..MarchOptions::default()
-                },
-            )),
+                    ..render_cmd::march_options(&args)
+                };
+                Some(VolumeScene::new(v, cells, ctf, opts))
+            }
             _ => None,
-        }
+        })
     };
-    let (unlit, lit) = (vscene(false), vscene(true));
     let sphere = match &scene_bvh {
         Some(s) => (s.center, s.radius),
         None => atoms_sphere(m, &a.geometry),
@@ -1175,12 +1204,8 @@ fn bench_scene(
         } else {
             None
         };
-        let vs = match (key.mode.volume(), key.mode.lit()) {
-            (false, _) => None,
-            (true, false) => unlit.as_ref(),
-            (true, true) => lit.as_ref(),
-        };
-        let mut renderer = Renderer::new(&key, geo, vs)?;
+        let vs = vscene(key.mode)?;
+        let mut renderer = Renderer::new(&key, geo, vs.as_ref())?;
         let pool = match pools.entry(key.threads) {
             std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::btree_map::Entry::Vacant(e) => e.insert(
@@ -1346,7 +1371,7 @@ fn figure4_table(o: &mut String, sel: &[&Measurement]) {
     use std::fmt::Write as _;
     let Some(k) = sel
         .iter()
-        .find(|m| m.key.mode.render_flags().is_some())
+        .find(|m| PAPER_FIGURE4.iter().any(|f| f.2 == Some(m.key.mode)))
         .map(|m| (m.key, m.isa))
     else {
         return;
@@ -1813,7 +1838,15 @@ mod tests {
         };
         assert_eq!(
             modes(&["modalities"]),
-            ["bs-shadows", "bs-ao", "path", "volume-lit", "vol+bs-lit"]
+            [
+                "bs-shadows",
+                "bs-ao",
+                "path",
+                "volume-lit",
+                "vol+bs-lit",
+                "volume-shadows",
+                "volume-lit-shadows"
+            ]
         );
         assert_eq!(
             modes(&["path,modalities,bs"]),
@@ -1823,6 +1856,8 @@ mod tests {
                 "bs-ao",
                 "volume-lit",
                 "vol+bs-lit",
+                "volume-shadows",
+                "volume-lit-shadows",
                 "bs"
             ]
         );
@@ -1900,7 +1935,24 @@ mod tests {
         let (o, _) = opts(BenchMode::VolBsShadows);
         assert_eq!(o.modality, Modality::Direct { shadows: true });
         assert!(o.volume_shadows);
-        assert!(BenchMode::VolBsShadows.volume() && !BenchMode::VolBsShadows.lit());
+        assert!(BenchMode::VolBsShadows.volume());
+        // The volume modes' marcher options: lighting and volumetric shadows as rendered.
+        let march = |m: BenchMode| {
+            render_cmd::march_options(&render_cmd::parse_render_flags(m.volume_flags()).unwrap())
+        };
+        let dir = volume::Light::Directional([1.0, 2.0, 1.5]);
+        assert_eq!(march(BenchMode::Volume), volume::MarchOptions::default());
+        assert_eq!(
+            march(BenchMode::VolumeLit).lighting,
+            volume::Lighting::Headlight
+        );
+        let vs = march(BenchMode::VolumeShadows);
+        assert_eq!(vs.lighting, volume::Lighting::Unlit);
+        assert_eq!(vs.shadows.map(|s| s.light), Some(dir));
+        let vls = march(BenchMode::VolumeLitShadows);
+        assert_eq!(vls.lighting, volume::Lighting::Directional([1.0, 2.0, 1.5]));
+        assert_eq!(vls.shadows.map(|s| s.light), Some(dir));
+        assert!(march(BenchMode::VolBsShadows).shadows.is_some());
         for m in [BenchMode::BsShadows, BenchMode::BsAo, BenchMode::Path] {
             assert!(m.geometry() && !m.volume(), "{m:?}");
         }

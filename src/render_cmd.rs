@@ -10,7 +10,10 @@ use render::{
     RenderOptions, SecondaryTraversal, TraceOptions, View,
 };
 use spmd::Isa;
-use volume::{ClassifiedTf, Lighting, MarchOptions, Preset, TransferFunction, VolumeScene};
+use volume::{
+    ClassifiedTf, Light, LightVolume, Lighting, MarchOptions, Preset, TransferFunction,
+    VolumeScene, VolumeShadows,
+};
 
 use crate::input::InputArgs;
 use crate::pipeline::{build_scene, build_volume, GeometryArgs, VolumeArgs};
@@ -71,6 +74,17 @@ fn parse_dir(s: &str) -> Result<[f32; 3], String> {
     }
 }
 
+/// Parses a point `x,y,z` (Å).
+fn parse_point(s: &str) -> Result<[f32; 3], String> {
+    let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
+    match v.as_slice() {
+        [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!(
+            "{s:?}: expected a point x,y,z in Å (three finite numbers)"
+        )),
+    }
+}
+
 /// Which of the paper's views (Table 3).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewArg {
@@ -117,11 +131,12 @@ pub struct RenderArgs {
     /// points `value r g b a` (value in [0,1] of the density range).
     #[arg(long, default_value = "coolwarm")]
     pub tf: String,
-    /// Volume: gradient lighting by central differences (headlight, or from --light-dir when
-    /// given).
+    /// Volume: gradient lighting by central differences (headlight, or from --light-dir /
+    /// --light-pos when given or when --volume-shadows is on).
     #[arg(long)]
     pub lit: bool,
-    /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir with hard shadows.
+    /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir or --light-pos with hard
+    /// shadows.
     #[arg(long)]
     pub shadows: bool,
     /// Ball-and-stick (bs, vol+bs): ambient occlusion with N cosine-distributed rays per hit.
@@ -130,22 +145,30 @@ pub struct RenderArgs {
     /// Ambient occlusion distance (Å).
     #[arg(long, default_value_t = 4.0)]
     pub ao_distance: f32,
-    /// Direction towards the (directional) light, world space `x,y,z`.
-    #[arg(long, value_parser = parse_dir)]
+    /// Direction towards a directional light, world space `x,y,z` (default 1,2,1.5).
+    #[arg(long, value_parser = parse_dir, conflicts_with = "light_pos")]
     pub light_dir: Option<[f32; 3]>,
+    /// Position of a point light instead, world space `x,y,z` in Å (no distance fall-off).
+    #[arg(long, value_parser = parse_point)]
+    pub light_pos: Option<[f32; 3]>,
     /// Light intensity (shadows: factor of max(0, n·l); path: irradiance / π).
     #[arg(long, default_value_t = 0.85)]
     pub light_intensity: f32,
     /// Ambient term of --shadows shading.
     #[arg(long, default_value_t = 0.2)]
     pub ambient: f32,
-    /// vol+bs with --shadows (or path): shadow rays are attenuated by the volume's
-    /// transmittance (soft shadows, paper §4.5).
+    /// The volume casts shadows (paper §4.5, Figure 4): with --mode volume every visible
+    /// sample is shadowed by the density towards the light; with --mode vol+bs --shadows also
+    /// the balls and sticks (soft shadows).
     #[arg(long)]
     pub volume_shadows: bool,
     /// Step of shadow rays through the volume (voxels).
     #[arg(long, default_value_t = 2.0)]
     pub shadow_step: f32,
+    /// Volumetric shadows: march a shadow ray from every shaded volume sample instead of
+    /// looking up the light volume precomputed every 2 voxels (slower; the reference).
+    #[arg(long)]
+    pub shadow_rays: bool,
     /// Path tracing: BRDF of the atoms.
     #[arg(long, value_enum, default_value_t = MaterialArg::Metal)]
     pub material: MaterialArg,
@@ -398,22 +421,18 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         _ => None,
     };
     let vscene = match (&vol, &classified) {
-        (Some((v, cells)), Some(ctf)) => Some(VolumeScene::new(
-            v,
-            cells,
-            ctf,
-            MarchOptions {
-                macrocells: !args.no_macrocells,
-                preintegrated: !args.no_preintegration,
-                lighting: match (args.lit, args.light_dir) {
-                    (false, _) => Lighting::Unlit,
-                    (true, None) => Lighting::Headlight,
-                    (true, Some(l)) => Lighting::Directional(l),
-                },
-                ..MarchOptions::default()
-            },
-        )),
+        (Some((v, cells)), Some(ctf)) => {
+            Some(VolumeScene::new(v, cells, ctf, march_options(&args)))
+        }
         _ => None,
+    };
+    let light_volume = match (&vscene, args.shadow_rays) {
+        (Some(vs), false) => build_light_volume(vs, isa, &verbose),
+        _ => None,
+    };
+    let vscene = match (vscene, &light_volume) {
+        (Some(vs), Some(lv)) => Some(vs.with_light_volume(lv)),
+        (vs, _) => vs,
     };
     let [r, g, b] = background(&args);
     let opt = RenderOptions {
@@ -453,7 +472,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
                 w,
                 h,
                 args.mode.name(),
-                if args.lit { " lit" } else { "" },
+                volume_suffix(&args),
                 stats.mrays_per_s(),
                 stats.fps()
             ));
@@ -467,9 +486,43 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         output.display(),
         args.mode.name(),
         modality_name(&args),
-        if args.lit { " lit" } else { "" }
+        volume_suffix(&args)
     );
     Ok(())
+}
+
+/// " lit", " volume-shadowed" or both: how the volume is shaded, for reports.
+fn volume_suffix(args: &RenderArgs) -> String {
+    let mut s = String::new();
+    if args.lit {
+        s.push_str(" lit");
+    }
+    if args.volume_shadows && args.mode == Mode::Volume {
+        s.push_str(" volume-shadowed");
+    }
+    s
+}
+
+/// Stride (density voxels) of the light volume of volumetric shadows.
+pub(crate) const LIGHT_VOLUME_STRIDE: usize = 2;
+
+/// The light volume of `vs`'s volumetric shadows (`None` without them), timed.
+pub(crate) fn build_light_volume(
+    vs: &VolumeScene,
+    isa: Isa,
+    verbose: &dyn Fn(String),
+) -> Option<LightVolume> {
+    let sh = vs.opts.shadows?;
+    let t = Instant::now();
+    let lv = LightVolume::build(isa, vs, sh, LIGHT_VOLUME_STRIDE);
+    verbose(format!(
+        "light:   {:.3} s  light volume {:?} (every {} voxels), {:.1} MB",
+        t.elapsed().as_secs_f64(),
+        lv.grid.dims,
+        LIGHT_VOLUME_STRIDE,
+        lv.bytes() as f64 / 1e6
+    ));
+    Some(lv)
 }
 
 /// The `RenderArgs` of `bnsview render FLAGS` (clap's defaults for every flag not given), so
@@ -506,12 +559,43 @@ pub(crate) fn samples_per_pixel(args: &RenderArgs) -> u32 {
     }
 }
 
+/// The light of the flags: `--light-pos`, else `--light-dir`, else the default direction.
+pub(crate) fn light(args: &RenderArgs) -> Light {
+    match (args.light_pos, args.light_dir) {
+        (Some(p), _) => Light::Point(p),
+        (None, Some(d)) => Light::Directional(d),
+        (None, None) => TraceOptions::default().light,
+    }
+}
+
+/// The volume marcher's options from the flags: lighting (headlight unless a light is given
+/// or shadows need one), volumetric shadows, macrocells and pre-integration.
+pub(crate) fn march_options(args: &RenderArgs) -> MarchOptions {
+    let explicit = args.light_pos.is_some() || args.light_dir.is_some() || args.volume_shadows;
+    let lighting = match (args.lit, explicit, light(args)) {
+        (false, _, _) => Lighting::Unlit,
+        (true, false, _) => Lighting::Headlight,
+        (true, true, Light::Directional(d)) => Lighting::Directional(d),
+        (true, true, Light::Point(p)) => Lighting::Point(p),
+    };
+    MarchOptions {
+        macrocells: !args.no_macrocells,
+        preintegrated: !args.no_preintegration,
+        lighting,
+        shadows: args.volume_shadows.then(|| VolumeShadows {
+            light: light(args),
+            step_voxels: args.shadow_step,
+        }),
+        ..MarchOptions::default()
+    }
+}
+
 /// Options of the ray tracing modalities from the flags.
 pub(crate) fn trace_options(args: &RenderArgs, modality: Modality) -> TraceOptions {
     let [r, g, b] = background(args);
     TraceOptions {
         modality,
-        light_dir: args.light_dir.unwrap_or(TraceOptions::default().light_dir),
+        light: light(args),
         light_intensity: args.light_intensity,
         ambient: args.ambient,
         background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
@@ -566,14 +650,14 @@ pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
     if args.volume_shadows {
         match m {
             Mode::VolBs if args.shadows => {}
-            Mode::Volume => bail!(
-                "volumetric shadows of the volume alone (--mode volume --volume-shadows) are \
-                 not available yet; available: --mode vol+bs --shadows --volume-shadows \
-                 (ball-and-stick shadowed by the volume) and --mode volume --lit"
+            Mode::Volume => {}
+            Mode::VolBs => bail!(
+                "--mode vol+bs --volume-shadows needs --shadows (the balls and sticks are then \
+                 shadowed by the geometry and the volume, and the volume by itself)"
             ),
             _ => bail!(
-                "--volume-shadows attenuates shadow rays by the volume: use it with \
-                 --mode vol+bs --shadows"
+                "--volume-shadows: the volume casts the shadows, so use it with --mode volume \
+                 or --mode vol+bs --shadows"
             ),
         }
     }

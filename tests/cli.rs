@@ -149,8 +149,10 @@ fn render_reports_bad_input_with_file_and_line() {
 fn render_modalities_write_pngs_and_refuse_what_is_missing() {
     let dir = std::env::temp_dir().join(format!("bnsview-modal-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let cases: [&[&str]; 5] = [
+    let vol = ["--voxels-per-angstrom", "1"];
+    let cases: [&[&str]; 9] = [
         &["--shadows"],
+        &["--shadows", "--light-pos", "0,40,0"],
         &["--ao", "2"],
         &["--mode", "path", "--spp", "2", "--material", "metal"],
         &["--mode", "path", "--spp", "1", "--material", "diffuse"],
@@ -159,8 +161,27 @@ fn render_modalities_write_pngs_and_refuse_what_is_missing() {
             "vol+bs",
             "--shadows",
             "--volume-shadows",
-            "--voxels-per-angstrom",
-            "1",
+            vol[0],
+            vol[1],
+        ],
+        &["--mode", "volume", "--volume-shadows", vol[0], vol[1]],
+        &[
+            "--mode",
+            "volume",
+            "--lit",
+            "--volume-shadows",
+            "--light-pos",
+            "5,30,5",
+            vol[0],
+            vol[1],
+        ],
+        &[
+            "--mode",
+            "volume",
+            "--volume-shadows",
+            "--shadow-rays",
+            vol[0],
+            vol[1],
         ],
     ];
     for (i, extra) in cases.iter().enumerate() {
@@ -183,12 +204,24 @@ fn render_modalities_write_pngs_and_refuse_what_is_missing() {
             "--atoms",
             "2000",
             "--mode",
-            "volume",
+            "vol+bs",
             "--volume-shadows",
             "-o",
         ])
         .arg(dir.join("x.png")));
-    assert!(!ok && err.contains("not available"), "{err}");
+    assert!(!ok && err.contains("needs --shadows"), "{err}");
+    let (ok, _, err) = run(bnsview()
+        .args([
+            "render",
+            "--light-dir",
+            "1,0,0",
+            "--light-pos",
+            "0,0,0",
+            "-o",
+        ])
+        .arg(dir.join("x.png")));
+    assert!(!ok && err.contains("cannot be used with"), "{err}");
+    assert!(!dir.join("x.png").exists());
     let (ok, _, err) = run(bnsview()
         .args([
             "render",

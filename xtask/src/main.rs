@@ -22,7 +22,8 @@ fn main() -> Result<()> {
             eprintln!("usage: cargo xtask matrix [--quick] | cargo xtask bench [BENCH ARGS]");
             eprintln!("  matrix   tests per ISA, kernel benches with speedups over scalar,");
             eprintln!("           builds for target-cpu x86-64 / x86-64-v3 / x86-64-v4");
-            eprintln!("  --quick  short bench runs (criterion --quick), no x86-64-v3 build");
+            eprintln!("  --quick  short bench runs (criterion --quick), one wider baseline: the");
+            eprintln!("           widest this CPU runs (x86-64-v4 with AVX-512, else v3)");
             eprintln!("  bench    `bnsview bench` in release mode (the paper's Tables 1-3);");
             eprintln!("           e.g. cargo xtask bench --quick --json out.json");
             std::process::exit(2)
@@ -175,6 +176,35 @@ fn json_number_after(text: &str, key1: &str, key2: &str) -> Option<f64> {
     rest[..end].parse().ok()
 }
 
+/// Can this CPU run code compiled for `-C target-cpu=cpu`?
+fn cpu_can_run(cpu: &str) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let v3 = is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("fma")
+            && is_x86_feature_detected!("bmi1")
+            && is_x86_feature_detected!("bmi2")
+            && is_x86_feature_detected!("lzcnt")
+            && is_x86_feature_detected!("movbe");
+        match cpu {
+            "x86-64" => true,
+            "x86-64-v3" => v3,
+            "x86-64-v4" => {
+                v3 && is_x86_feature_detected!("avx512f")
+                    && is_x86_feature_detected!("avx512bw")
+                    && is_x86_feature_detected!("avx512cd")
+                    && is_x86_feature_detected!("avx512dq")
+                    && is_x86_feature_detected!("avx512vl")
+            }
+            _ => false,
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        cpu == "x86-64"
+    }
+}
+
 fn matrix(quick: bool) -> Result<()> {
     let t0 = Instant::now();
     let isas = supported_isas()?;
@@ -213,12 +243,21 @@ fn matrix(quick: bool) -> Result<()> {
     let asm_rows = asm_check()?;
     all_ok &= asm_rows.iter().all(|r| r.ok);
 
-    // 4. Portable builds: the same binary must select AVX-512 at run time whatever the
-    //    compile-time baseline (each target-cpu gets its own target dir).
-    //    `--quick` (CI) skips x86-64-v3: each extra baseline rebuilds every dependency
-    //    (~5 min on 2 cores) and v4 already covers "compiled for a wider baseline".
+    // 4. Portable builds: the same binary must select the widest backend at run time
+    //    whatever the compile-time baseline (each target-cpu gets its own target dir).
+    //    `--quick` (CI) builds only the widest baseline this CPU can run besides x86-64: each
+    //    extra baseline rebuilds every dependency (~5 min on 2 cores). A baseline the CPU
+    //    cannot run (x86-64-v4 without AVX-512) is built but not run.
+    let widest_runnable = CPUS
+        .into_iter()
+        .rev()
+        .find(|c| cpu_can_run(c))
+        .unwrap_or("x86-64");
     let mut cpu_rows = Vec::new();
-    for cpu in CPUS.into_iter().filter(|&c| !(quick && c == "x86-64-v3")) {
+    for cpu in CPUS
+        .into_iter()
+        .filter(|&c| !quick || c == "x86-64" || c == widest_runnable)
+    {
         // The default build is the x86-64 baseline; the others get their own target dir
         // because RUSTFLAGS rebuild every dependency.
         let (dir, flags) = if cpu == "x86-64" {
@@ -234,17 +273,20 @@ fn matrix(quick: bool) -> Result<()> {
             .arg(&dir)
             .env("RUSTFLAGS", flags);
         let (ok, _) = run_logged(c, &format!("cargo build --release (target-cpu={cpu})"))?;
-        let selected = if ok {
+        let runnable = cpu_can_run(cpu);
+        let selected = if ok && runnable {
             let out = Command::new(dir.join("release").join("bnsview"))
                 .arg("--version")
                 .env_remove("BNS_ISA")
                 .output()?;
             String::from_utf8_lossy(&out.stdout).trim().to_string()
+        } else if ok {
+            "built; not run (this CPU lacks the baseline's instructions)".to_string()
         } else {
             "build failed".to_string()
         };
         let expect = isas.last().cloned().unwrap_or_default();
-        let good = ok && selected.contains(&format!("isa: {expect},"));
+        let good = ok && (!runnable || selected.contains(&format!("isa: {expect},")));
         all_ok &= good;
         cpu_rows.push((cpu, selected, good));
     }

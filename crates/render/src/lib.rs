@@ -21,6 +21,7 @@ pub use trace::{
     ambient_occlusion_at, occluded, render_modal, render_modal_into, trace, Accum, Material,
     Modality, SecondaryTraversal, TraceOptions, Traced,
 };
+pub use volume::Light;
 
 /// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
 pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {

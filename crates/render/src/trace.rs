@@ -33,7 +33,7 @@ use std::time::Instant;
 use bvh::{intersect_record, surface, Bvh, PacketHit, RayPacket};
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Scalar, Simd, V3};
-use volume::{ShadowTf, VolumeScene};
+use volume::{Light, VolumeScene};
 
 use crate::camera::Camera;
 use crate::framebuffer::{Framebuffer, RenderError};
@@ -99,8 +99,9 @@ pub enum SecondaryTraversal {
 pub struct TraceOptions {
     /// What to compute.
     pub modality: Modality,
-    /// Direction *towards* the light (world space, need not be unit).
-    pub light_dir: [f32; 3],
+    /// The light of `Direct` shading and of the path tracer's next-event estimation
+    /// (directional, or a point without distance fall-off).
+    pub light: Light,
     /// Light intensity (Direct: factor of `max(0, n·l)`; Path: irradiance / π).
     pub light_intensity: f32,
     /// Ambient term of `Direct`.
@@ -124,7 +125,7 @@ impl Default for TraceOptions {
     fn default() -> Self {
         TraceOptions {
             modality: Modality::Direct { shadows: true },
-            light_dir: [1.0, 2.0, 1.5],
+            light: Light::Directional([1.0, 2.0, 1.5]),
             light_intensity: 0.85,
             ambient: 0.2,
             background: [1.0, 1.0, 1.0],
@@ -133,18 +134,6 @@ impl Default for TraceOptions {
             shadow_step_voxels: 2.0,
             exposure: 1.0,
             secondary: SecondaryTraversal::Packet,
-        }
-    }
-}
-
-impl TraceOptions {
-    fn light_unit(&self) -> [f32; 3] {
-        let l = self.light_dir;
-        let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-        if n > 0.0 && n.is_finite() {
-            [l[0] / n, l[1] / n, l[2] / n]
-        } else {
-            [0.0, 1.0, 0.0]
         }
     }
 }
@@ -237,7 +226,6 @@ pub fn render_modal_into(
     let start = Instant::now();
     let (w, h) = (acc.width as usize, acc.height as usize);
     let view = ViewRays::new(camera, w, h);
-    let shadow_tf = volume.map(|v| ShadowTf::new(v.tf));
     let ntx = w.div_ceil(TILE);
     let first_sample = acc.samples;
     if w > 0 && h > 0 && spp > 0 {
@@ -252,7 +240,6 @@ pub fn render_modal_into(
                         isa.dispatch(ModalKernel {
                             scene,
                             volume,
-                            shadow_tf: shadow_tf.as_ref(),
                             view: &view,
                             opt,
                             x0: tx * TILE,
@@ -735,7 +722,6 @@ fn spawn<S: Simd>(s: S, bvh: &Bvh, tr: &Traced<S>) -> V3<S> {
 struct ModalKernel<'a> {
     scene: &'a Scene,
     volume: Option<&'a VolumeScene<'a>>,
-    shadow_tf: Option<&'a ShadowTf>,
     view: &'a ViewRays,
     opt: &'a TraceOptions,
     x0: usize,
@@ -846,18 +832,18 @@ fn shade_sample<S: Simd>(
     let bg = V3::splat(s, opt.background);
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
-    let l = V3::splat(s, opt.light_unit());
     match opt.modality {
         Modality::Direct { shadows } => {
             let tr = trace(s, Some(k.scene), k.volume, ray, stack);
             let mut c = bg;
             if s.any(tr.mask) {
+                let o = spawn(s, &k.scene.bvh, &tr);
+                let (l, dist) = opt.light.towards(s, o);
                 let ndl = s.max(tr.n.dot(l), zero);
                 let lit = tr.mask & s.gt(ndl, zero);
                 let mut vis = s.select(lit, one, zero);
                 if shadows && s.any(lit) {
-                    let o = spawn(s, &k.scene.bvh, &tr);
-                    vis = visibility(s, k, o, l, lit, stack);
+                    vis = visibility(s, k, o, l, dist, lit, stack);
                 }
                 let shade = s.splat(opt.ambient) + s.splat(opt.light_intensity) * ndl * vis;
                 c = V3::select(s, tr.mask, tr.color.scale(shade), bg);
@@ -910,10 +896,11 @@ fn shade_sample<S: Simd>(
                 match material {
                     Material::Diffuse => {
                         if opt.light_intensity > 0.0 {
+                            let (l, dist) = opt.light.towards(s, o);
                             let ndl = s.max(n.dot(l), zero);
                             let lit = alive & s.gt(ndl, zero);
                             if s.any(lit) {
-                                let vis = visibility(s, k, o, l, lit, stack);
+                                let vis = visibility(s, k, o, l, dist, lit, stack);
                                 let e = s.splat(opt.light_intensity) * ndl * vis;
                                 radiance =
                                     V3::select(s, lit, radiance + (tp * albedo).scale(e), radiance);
@@ -955,14 +942,17 @@ fn shade_sample<S: Simd>(
     }
 }
 
-/// Visibility of the light along unit `l` from origins `o` (lanes `m`): 0 where geometry is
-/// in the way, else the volume's transmittance when volume shadows are on, else 1.
+/// Visibility of the light along unit `l` from origins `o` over `(0, dist)` Å (lanes `m`):
+/// 0 where geometry is in the way, else the volume's transmittance when volume shadows are
+/// on, else 1.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn visibility<S: Simd>(
     s: S,
     k: &ModalKernel<'_>,
     o: V3<S>,
     l: V3<S>,
+    dist: S::F32,
     m: S::M,
     stack: &mut [u32],
 ) -> S::F32 {
@@ -972,24 +962,15 @@ fn visibility<S: Simd>(
         o,
         d: l,
         tmin: zero,
-        tmax: s.splat(f32::INFINITY),
+        tmax: dist,
         active: m,
     };
     let occ = occluded_by(s, &k.scene.bvh, k.opt.secondary, &sray, stack);
     let free = m & !occ;
     let mut vis = s.select(free, one, zero);
-    if let (true, Some(vs), Some(stf)) = (k.opt.volume_shadows, k.volume, k.shadow_tf) {
+    if let (true, Some(vs)) = (k.opt.volume_shadows, k.volume) {
         if s.any(free) {
-            let tr = volume::transmittance(
-                s,
-                vs,
-                stf,
-                o,
-                l,
-                s.splat(f32::INFINITY),
-                free,
-                k.opt.shadow_step_voxels,
-            );
+            let tr = volume::transmittance(s, vs, o, l, dist, free, k.opt.shadow_step_voxels);
             vis = s.select(free, tr, vis);
         }
     }

@@ -5,8 +5,8 @@
 use bvh::scenes::random_molecule;
 use bvh::{Balls, Geometry, Ray, Sticks};
 use render::{
-    ambient_occlusion_at, render_modal, rgba, Camera, Framebuffer, Material, Modality, Scene,
-    SecondaryTraversal, TraceOptions, View,
+    ambient_occlusion_at, render_modal, rgba, Camera, Framebuffer, Light, Material, Modality,
+    Scene, SecondaryTraversal, TraceOptions, View,
 };
 use spmd::Isa;
 
@@ -66,14 +66,18 @@ fn ortho_ray(cam: &Camera, w: u32, h: u32, x: u32, y: u32) -> Ray {
     Ray::new(o, cam.forward)
 }
 
-#[test]
-fn hard_shadow_of_a_sphere_on_a_slab_is_where_geometry_puts_it() {
+/// Renders `sphere_over_slab` lit by `light` with shadows on every backend and both secondary
+/// traversals, and checks every slab pixel against `clearance(p)`: the distance (Å) by which
+/// the segment from hit point `p` towards the light misses the ball's centre, minus `R`
+/// (negative: in shadow), `None` where the slab's own bumps may shadow the point. Pixels
+/// within 0.1 Å of the shadow's edge are not judged.
+fn check_shadow(light: Light, clearance: impl Fn([f64; 3]) -> Option<f64>) {
     let scene = sphere_over_slab();
     let cam = Camera::orthographic([0.0, 30.0, 22.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 22.0);
     let (w, h) = (128, 128);
     let opt = TraceOptions {
         modality: Modality::Direct { shadows: true },
-        light_dir: [0.0, 1.0, 0.0],
+        light,
         light_intensity: 0.8,
         ambient: 0.2,
         ..TraceOptions::default()
@@ -94,39 +98,73 @@ fn hard_shadow_of_a_sphere_on_a_slab_is_where_geometry_puts_it() {
                     if hit.prim >= slab_prims || hit.n[1] < 0.2 {
                         continue; // the sphere itself, or a grazing slab point
                     }
-                    // Analytic: light straight up, so the point is in the sphere's shadow iff
-                    // its vertical line passes through the disc of radius R about the axis.
                     let p: [f64; 3] =
                         std::array::from_fn(|a| ray.o[a] as f64 + ray.d[a] as f64 * hit.t as f64);
-                    let rho = (p[0] * p[0] + p[2] * p[2]).sqrt();
-                    if (rho - R).abs() < 0.1 {
+                    // Judge only points facing the light (n·l > 0.2): the rest are dark anyway.
+                    let l: [f64; 3] = match light {
+                        Light::Directional(d) => d.map(|x| x as f64),
+                        Light::Point(q) => std::array::from_fn(|a| q[a] as f64 - p[a]),
+                    };
+                    let ln = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+                    let ndl: f64 = (0..3).map(|a| hit.n[a] as f64 * l[a] / ln).sum();
+                    let Some(c) = clearance(p).filter(|_| ndl > 0.2) else {
+                        continue;
+                    };
+                    if c.abs() < 0.1 {
                         continue; // too close to the shadow's edge to call
                     }
-                    let shadowed = rho < R;
                     let red = fb.pixel(x, y)[0] as i32;
-                    if shadowed {
+                    if c < 0.0 {
                         n_shadow += 1;
                         assert!(
                             (red - ambient).abs() <= 1,
-                            "{isa} {secondary:?}: pixel ({x},{y}) at ρ = {rho:.2} Å must be in \
-                             shadow (ambient {ambient}), got {red}"
+                            "{isa} {secondary:?} {light:?}: pixel ({x},{y}) at {p:.2?} must be \
+                             in shadow (ambient {ambient}), got {red}"
                         );
                     } else {
                         n_lit += 1;
                         assert!(
                             red > ambient + 30,
-                            "{isa} {secondary:?}: pixel ({x},{y}) at ρ = {rho:.2} Å must be lit, \
-                             got {red}"
+                            "{isa} {secondary:?} {light:?}: pixel ({x},{y}) at {p:.2?} must be \
+                             lit, got {red}"
                         );
                     }
                 }
             }
             assert!(
                 n_shadow > 100 && n_lit > 1000,
-                "{n_shadow} shadow, {n_lit} lit pixels"
+                "{light:?}: {n_shadow} shadow, {n_lit} lit pixels"
             );
         }
     }
+}
+
+#[test]
+fn hard_shadow_of_a_sphere_on_a_slab_is_where_geometry_puts_it() {
+    // Light straight up: the point is in the sphere's shadow iff its vertical line passes
+    // through the disc of radius R about the axis.
+    check_shadow(Light::Directional([0.0, 1.0, 0.0]), |p| {
+        Some((p[0] * p[0] + p[2] * p[2]).sqrt() - R)
+    });
+}
+
+#[test]
+fn point_light_shadow_is_the_cone_from_the_light() {
+    // A point light 9 Å above the ball's centre, off the axis: the shadow is where the
+    // segment from the slab point to the light passes within R of the centre (a wider,
+    // shifted disc than the directional light's). Points that see the light lower than 55°
+    // above the horizon are not judged (the slab's bumps shadow each other there).
+    let q = [1.5f64, H as f64 + 9.0, 0.5];
+    check_shadow(Light::Point([q[0] as f32, q[1] as f32, q[2] as f32]), |p| {
+        let c = [0.0, H as f64, 0.0];
+        let d: [f64; 3] = std::array::from_fn(|a| q[a] - p[a]);
+        let w: [f64; 3] = std::array::from_fn(|a| c[a] - p[a]);
+        let dd: f64 = d.iter().map(|x| x * x).sum();
+        let u = (d.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>() / dd).clamp(0.0, 1.0);
+        let dist2: f64 = (0..3).map(|a| (w[a] - u * d[a]).powi(2)).sum();
+        let horizontal = (d[0] * d[0] + d[2] * d[2]).sqrt();
+        (d[1] > horizontal * 55f64.to_radians().tan()).then(|| dist2.sqrt() - R)
+    });
 }
 
 #[test]
@@ -135,7 +173,7 @@ fn shadows_off_means_no_shadow() {
     let cam = Camera::orthographic([0.0, 30.0, 22.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 22.0);
     let opt = TraceOptions {
         modality: Modality::Direct { shadows: false },
-        light_dir: [0.0, 1.0, 0.0],
+        light: Light::Directional([0.0, 1.0, 0.0]),
         ..TraceOptions::default()
     };
     let (fb, _, _) = render_modal(&scene, None, &cam, 64, 64, &opt, 1, Isa::detect()).unwrap();

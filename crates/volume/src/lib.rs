@@ -54,6 +54,7 @@
 //! (`march::<S>(s, &scene, orig, dir, tmax, active)` → `[r, g, b, a]` varying).
 
 pub mod grid;
+pub mod light;
 pub mod macrocell;
 pub mod march;
 pub mod shadow;
@@ -63,11 +64,13 @@ pub use grid::{
     build_density, default_budget_bytes, estimate_bytes, DensityParams, Grid, Volume, VolumeData,
     VolumeFormat,
 };
+pub use light::LightVolume;
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{
     classify_values, march, march_rays, sample_points, Lighting, MarchOptions, Rays, VolumeScene,
+    VolumeShadows,
 };
-pub use shadow::{transmittance, ShadowTf};
+pub use shadow::{transmittance, Light};
 pub use tf::{
     preintegrate, ClassifiedTf, ControlPoint, Preset, TfError, TransferFunction, TF_SIZE,
 };

@@ -19,7 +19,9 @@
 use spmd::{Isa, Kernel, Simd, V3};
 
 use crate::grid::{Grid, Volume, VolumeData};
+use crate::light::LightVolume;
 use crate::macrocell::{Macrocells, MACROCELL};
+use crate::shadow::{march_tau, Light};
 use crate::tf::ClassifiedTf;
 
 /// Shading of the volume samples.
@@ -28,11 +30,27 @@ pub enum Lighting {
     /// Emission/absorption only (the paper's "volume").
     #[default]
     Unlit,
-    /// Diffuse, two-sided, light at the eye: colour × (0.3 + 0.7·|n·v|), n the normalised
-    /// gradient by central differences (6 extra trilinear samples per lit sample).
+    /// Diffuse, two-sided, light at the eye: colour × (a + (1 − a)·|n·v|), `n` the normalised
+    /// gradient by central differences (6 extra trilinear samples per lit sample), `a` the
+    /// ambient term of [`MarchOptions`] (0.3).
     Headlight,
     /// As `Headlight` with a fixed direction towards the light (world space, need not be unit).
     Directional([f32; 3]),
+    /// As `Headlight` with the light at this point (world space, Å): `l` per sample.
+    Point([f32; 3]),
+}
+
+/// Volumetric shadows (paper §4.5, Figure 4): every sample the transfer function makes
+/// visible sends a shadow ray through the density towards `light`
+/// ([`crate::shadow`]; coarser step, midpoint rule, one `exp`) and its colour is scaled by
+/// `ambient + (1 − ambient)·T` (unlit) or `ambient + (1 − ambient)·|n·l|·T` (lit), `T` the
+/// transmittance. Geometry does not shadow the volume.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeShadows {
+    /// The light the shadows are cast from.
+    pub light: crate::shadow::Light,
+    /// Step of the shadow rays, voxels (default 2; the primary step is 0.5).
+    pub step_voxels: f32,
 }
 
 /// Options of the marcher.
@@ -47,6 +65,11 @@ pub struct MarchOptions {
     pub lighting: Lighting,
     /// Stop a ray when its opacity reaches this. Default 0.99.
     pub opacity_cutoff: f32,
+    /// Shadows of the volume on itself (`None`: off, the default).
+    pub shadows: Option<VolumeShadows>,
+    /// Ambient term of lighting and shadows: colour × (ambient + (1 − ambient)·|n·l|·T).
+    /// Default 0.3.
+    pub ambient: f32,
 }
 
 impl Default for MarchOptions {
@@ -56,6 +79,8 @@ impl Default for MarchOptions {
             preintegrated: true,
             lighting: Lighting::Unlit,
             opacity_cutoff: 0.99,
+            shadows: None,
+            ambient: 0.3,
         }
     }
 }
@@ -72,6 +97,9 @@ pub struct VolumeScene<'a> {
     pub tf: &'a ClassifiedTf,
     /// Options.
     pub opts: MarchOptions,
+    /// Precomputed transmittance for `opts.shadows` ([`VolumeScene::with_light_volume`]);
+    /// without it every shaded sample marches its own shadow ray (the reference).
+    pub light: Option<&'a LightVolume>,
 }
 
 impl<'a> VolumeScene<'a> {
@@ -93,7 +121,22 @@ impl<'a> VolumeScene<'a> {
             cells,
             tf,
             opts,
+            light: None,
         }
+    }
+
+    /// Volumetric shadows from a precomputed light volume instead of a shadow ray per shaded
+    /// sample. Panics unless `light` was built for this volume's lattice and for
+    /// `opts.shadows` (same light and step).
+    pub fn with_light_volume(mut self, light: &'a LightVolume) -> Self {
+        let g = &self.volume.grid;
+        assert!(
+            (0..3).all(|a| light.grid.dims[a] == (g.dims[a] - 1).div_ceil(light.stride) + 1)
+                && self.opts.shadows == Some(light.shadows),
+            "VolumeScene: the light volume was built for another lattice, light or step"
+        );
+        self.light = Some(light);
+        self
     }
 }
 
@@ -236,6 +279,31 @@ pub fn march<S: Simd>(
     }
 }
 
+/// Lanes `m` whose macrocell `c` (per-axis indices, inside the grid of `ncells`) the transfer
+/// function does not make empty: max opacity over the cell's bin range, widened by one bin
+/// on each side (interpolated values may round past the stored min/max), above zero.
+#[inline(always)]
+pub(crate) fn cell_occupied<S: Simd>(
+    s: S,
+    cells: &Macrocells,
+    tf: &ClassifiedTf,
+    c: [S::I32; 3],
+    ncells: [i32; 3],
+    m: S::M,
+) -> S::M {
+    let zero = s.splat(0.0);
+    let ci = c[0]
+        + s.mul_i(c[1], s.splat_i(ncells[0]))
+        + s.mul_i(c[2], s.splat_i(ncells[0] * ncells[1]));
+    let i2 = s.shl(ci, 1);
+    let mn = s.gather(&cells.minmax, i2, m, zero);
+    let mx = s.gather(&cells.minmax, i2 + s.splat_i(1), m, zero);
+    let b0 = s.max_i(bin(s, tf, mn) - s.splat_i(1), s.splat_i(0));
+    let b1 = s.min_i(bin(s, tf, mx) + s.splat_i(1), s.splat_i(255));
+    let occ = s.gather(&tf.range_max, s.shl(b0, 8) + b1, m, zero);
+    m & s.gt(occ, zero)
+}
+
 /// Per-lane 3D DDA state over macrocells (grid coordinates / 8).
 struct Dda<S: Simd> {
     c: [S::I32; 3],
@@ -359,13 +427,21 @@ fn march_impl<S: Simd, V: Voxels>(
     }
 
     let lit = opts.lighting != Lighting::Unlit;
-    let light = match opts.lighting {
-        Lighting::Directional(l) => {
-            let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt().max(1e-30);
-            V3::splat(s, [l[0] / n, l[1] / n, l[2] / n])
-        }
-        _ => -dir.normalize(s),
+    // Lights in grid coordinates (the grid is isotropic, so directions are unchanged).
+    let grid_light = |l: Light| match l {
+        Light::Directional(d) => Light::Directional(d),
+        Light::Point(q) => Light::Point(core::array::from_fn(|a| (q[a] - g.origin[a]) / g.spacing)),
     };
+    let shade_light = match opts.lighting {
+        Lighting::Directional(l) => Some(Light::Directional(l)),
+        Lighting::Point(q) => Some(grid_light(Light::Point(q))),
+        _ => None,
+    };
+    let headlight = -dir.normalize(s);
+    let shadows = opts
+        .shadows
+        .map(|sh| (grid_light(sh.light), sh.step_voxels));
+    let ambient = s.splat(opts.ambient);
     let cutoff = s.splat(opts.opacity_cutoff);
     let preint = opts.preintegrated;
     loop {
@@ -377,17 +453,7 @@ fn march_impl<S: Simd, V: Voxels>(
             if s.none(need) {
                 break;
             }
-            let ci = dda.c[0]
-                + s.mul_i(dda.c[1], s.splat_i(ncells[0]))
-                + s.mul_i(dda.c[2], s.splat_i(ncells[0] * ncells[1]));
-            let i2 = s.shl(ci, 1);
-            let mn = s.gather(&scene.cells.minmax, i2, need, zero);
-            let mx = s.gather(&scene.cells.minmax, i2 + s.splat_i(1), need, zero);
-            // Widen by one bin on each side: interpolated values may round past min/max.
-            let b0 = s.max_i(bin(s, tf, mn) - s.splat_i(1), s.splat_i(0));
-            let b1 = s.min_i(bin(s, tf, mx) + s.splat_i(1), s.splat_i(255));
-            let occ = s.gather(&tf.range_max, s.shl(b0, 8) + b1, need, zero);
-            let ne = need & s.gt(occ, zero);
+            let ne = need & cell_occupied(s, scene.cells, tf, dda.c, ncells, need);
             // First segment touching the cell (never one already composited).
             let kf = s.floor((dda.t_in - t0) / dt);
             let kf = s.select(s.gt(t0 + kf * dt, dda.t_in), kf - one, kf);
@@ -452,10 +518,28 @@ fn march_impl<S: Simd, V: Voxels>(
                 s.gather(p, idx + s.splat_i(3), valid, zero),
             ]
         };
-        if lit {
+        if lit || shadows.is_some() {
             let shading = valid & s.gt(c[3], zero);
             if s.any(shading) {
-                let shade = shade(s, lat, og.mul_add(dg, tb), light, shading);
+                let pg = og.mul_add(dg, tb);
+                let mut f = one;
+                if lit {
+                    let l = match shade_light {
+                        Some(light) => light.towards(s, pg).0,
+                        None => headlight,
+                    };
+                    f = diffuse(s, lat, pg, l, shading);
+                }
+                if let Some((light, step)) = shadows {
+                    f *= match scene.light {
+                        Some(lv) => lv.sample(s, pg, shading),
+                        None => {
+                            let (l, dist) = light.towards(s, pg);
+                            march_tau(s, lat, scene.cells, tf, pg, l, dist, shading, step)
+                        }
+                    };
+                }
+                let shade = ambient + (one - ambient) * f;
                 for ch in c.iter_mut().take(3) {
                     *ch *= shade;
                 }
@@ -476,10 +560,10 @@ fn march_impl<S: Simd, V: Voxels>(
     acc
 }
 
-/// Diffuse shading factor `0.3 + 0.7·|n·l|` with `n` the normalised central-difference
-/// gradient at grid position `p` (1 where the gradient vanishes).
+/// Diffuse factor `|n·l|` with `n` the normalised central-difference gradient at grid
+/// position `p` (1 where the gradient vanishes).
 #[inline(always)]
-fn shade<S: Simd, V: Voxels>(s: S, lat: &Lattice<V>, p: V3<S>, l: V3<S>, m: S::M) -> S::F32 {
+fn diffuse<S: Simd, V: Voxels>(s: S, lat: &Lattice<V>, p: V3<S>, l: V3<S>, m: S::M) -> S::F32 {
     let one = s.splat(1.0);
     let e = |dx: f32, dy: f32, dz: f32| {
         V3::<S>::new(p.x + s.splat(dx), p.y + s.splat(dy), p.z + s.splat(dz))
@@ -491,7 +575,7 @@ fn shade<S: Simd, V: Voxels>(s: S, lat: &Lattice<V>, p: V3<S>, l: V3<S>, m: S::M
     let len2 = gv.dot(gv);
     let ok = s.gt(len2, s.splat(1e-20));
     let ndotl = s.abs(gv.dot(l)) * s.rsqrt(s.select(ok, len2, one));
-    s.select(ok, s.splat(0.3) + s.splat(0.7) * s.min(ndotl, one), one)
+    s.select(ok, s.min(ndotl, one), one)
 }
 
 /// A batch of rays as structure-of-arrays slices of equal length (world space, Å).

@@ -307,6 +307,9 @@ pub struct ClassifiedTf {
     /// Max opacity per voxel over entries `[i, j]` (either order), index `i·256 + j`;
     /// a macrocell is empty when this is 0 over its (widened) bin range.
     pub range_max: Vec<f32>,
+    /// Extinction `τ = −ln(1 − a)` per voxel of path for each bin (256 entries), `a` the
+    /// entry's opacity per voxel: what shadow rays sum (`crate::shadow`).
+    pub tau: Vec<f32>,
 }
 
 impl ClassifiedTf {
@@ -359,6 +362,11 @@ impl ClassifiedTf {
                 range_max[j * TF_SIZE + i] = m;
             }
         }
+        let tau = tf
+            .table
+            .iter()
+            .map(|e| extinction(e[3] as f64) as f32)
+            .collect();
         ClassifiedTf {
             lo,
             hi,
@@ -368,6 +376,7 @@ impl ClassifiedTf {
             preint,
             preint_half,
             range_max,
+            tau,
         }
     }
 

@@ -146,10 +146,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4.0)]
     pub ao_distance: f32,
     /// Direction towards a directional light, world space `x,y,z` (default 1,2,1.5).
-    #[arg(long, value_parser = parse_dir, conflicts_with = "light_pos")]
+    #[arg(long, value_parser = parse_dir, conflicts_with = "light_pos", allow_hyphen_values = true)]
     pub light_dir: Option<[f32; 3]>,
     /// Position of a point light instead, world space `x,y,z` in Å (no distance fall-off).
-    #[arg(long, value_parser = parse_point)]
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub light_pos: Option<[f32; 3]>,
     /// Light intensity (shadows: factor of max(0, n·l); path: irradiance / π).
     #[arg(long, default_value_t = 0.85)]

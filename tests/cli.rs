@@ -152,7 +152,7 @@ fn render_modalities_write_pngs_and_refuse_what_is_missing() {
     let vol = ["--voxels-per-angstrom", "1"];
     let cases: [&[&str]; 9] = [
         &["--shadows"],
-        &["--shadows", "--light-pos", "0,40,0"],
+        &["--shadows", "--light-pos", "-5,40,0"],
         &["--ao", "2"],
         &["--mode", "path", "--spp", "2", "--material", "metal"],
         &["--mode", "path", "--spp", "1", "--material", "diffuse"],

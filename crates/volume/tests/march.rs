@@ -155,13 +155,7 @@ fn single_atom_matches_double_precision_reference_integration() {
         z: vec![0.0],
         r: vec![r],
     };
-    let p = DensityParams {
-        voxels_per_angstrom: 8.0,
-        format: VolumeFormat::F32,
-        budget_bytes: None,
-    };
-    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
-    let mc = Macrocells::build(&v);
+    let (v, mc) = volume_of(&atoms, 8.0, VolumeFormat::F32);
     let tf = ramp_tf();
     let hi = v.max_value;
     let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);
@@ -213,12 +207,17 @@ fn shell_scene(format: VolumeFormat) -> (Volume, Macrocells) {
     a.y.extend(b.y);
     a.z.extend(b.z);
     a.r.extend(b.r);
+    volume_of(&a, 3.0, format)
+}
+
+/// The density grid of `atoms` at `vpa` voxels/Å (scalar build) and its macrocells.
+fn volume_of(atoms: &Atoms, vpa: f32, format: VolumeFormat) -> (Volume, Macrocells) {
     let p = DensityParams {
-        voxels_per_angstrom: 3.0,
+        voxels_per_angstrom: vpa,
         format,
         budget_bytes: None,
     };
-    let v = build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p).unwrap();
+    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
     let mc = Macrocells::build(&v);
     (v, mc)
 }
@@ -531,13 +530,7 @@ fn lighting_scales_colour_only() {
         z: vec![0.0],
         r: vec![1.5],
     };
-    let p = DensityParams {
-        voxels_per_angstrom: 8.0,
-        format: VolumeFormat::F32,
-        budget_bytes: None,
-    };
-    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
-    let mc = Macrocells::build(&v);
+    let (v, mc) = volume_of(&atoms, 8.0, VolumeFormat::F32);
     let ctf = ClassifiedTf::new(&ramp_tf(), 0.0, v.max_value, 0.5);
     let mut b = atom_rays(f32::INFINITY);
     b.push([-8.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
@@ -705,13 +698,7 @@ fn volumetric_shadows_match_double_precision_reference() {
         z: vec![0.0, -0.2],
         r: vec![1.5, 1.5],
     };
-    let p = DensityParams {
-        voxels_per_angstrom: 8.0,
-        format: VolumeFormat::F32,
-        budget_bytes: None,
-    };
-    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
-    let mc = Macrocells::build(&v);
+    let (v, mc) = volume_of(&atoms, 8.0, VolumeFormat::F32);
     let tf = ramp_tf();
     let hi = v.max_value;
     let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);

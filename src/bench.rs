@@ -1197,6 +1197,7 @@ fn bench_scene(
         None => atoms_sphere(m, &a.geometry),
     };
     let mut out = Vec::new();
+    let mut lights: Vec<volume::LightVolume> = Vec::new();
     for &(key, tables) in keys {
         let camera = camera_for(sphere, key.far, key.w, key.h);
         let geo = if key.mode.geometry() {
@@ -1205,6 +1206,23 @@ fn bench_scene(
             None
         };
         let vs = vscene(key.mode)?;
+        // Volumetric shadows read a light volume built once per light and scene, as
+        // `bnsview render` builds it once per picture (its build is preprocessing, printed,
+        // not part of the frame time).
+        let shadows = vs.as_ref().and_then(|v| v.opts.shadows);
+        if let (Some(v), Some(sh)) = (&vs, shadows) {
+            if !lights.iter().any(|l| l.shadows == sh) {
+                let lv = render_cmd::build_light_volume(v, Isa::detect(), &|msg| {
+                    eprintln!("bench: {scene}: {msg}")
+                });
+                lights.extend(lv);
+            }
+        }
+        let light = shadows.and_then(|sh| lights.iter().find(|l| l.shadows == sh));
+        let vs = match (vs, light) {
+            (Some(v), Some(l)) => Some(v.with_light_volume(l)),
+            (v, _) => v,
+        };
         let mut renderer = Renderer::new(&key, geo, vs.as_ref())?;
         let pool = match pools.entry(key.threads) {
             std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),

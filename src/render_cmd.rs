@@ -53,13 +53,25 @@ pub enum MaterialArg {
     Diffuse,
 }
 
-/// Traversal of secondary rays (`--secondary`).
+/// Traversal of secondary rays (`--secondary`, `--bounce-traversal`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SecondaryArg {
-    /// A pixel block's secondary rays as one packet, any-hit early exit.
+    /// A pixel block's secondary rays as one packet over the binary BVH.
     Packet,
-    /// One ray at a time (scalar traversal).
+    /// One ray at a time through the binary BVH (scalar traversal).
     Single,
+    /// One ray at a time through the 8-wide BVH (eight child boxes per SIMD op).
+    Wide,
+}
+
+impl From<SecondaryArg> for SecondaryTraversal {
+    fn from(a: SecondaryArg) -> Self {
+        match a {
+            SecondaryArg::Packet => SecondaryTraversal::Packet,
+            SecondaryArg::Single => SecondaryTraversal::Single,
+            SecondaryArg::Wide => SecondaryTraversal::Wide,
+        }
+    }
 }
 
 fn parse_dir(s: &str) -> Result<[f32; 3], String> {
@@ -187,9 +199,13 @@ pub struct RenderArgs {
     /// Seed of the random numbers of AO and path tracing (`--seed` seeds scene generators).
     #[arg(long, default_value_t = 1)]
     pub sample_seed: u32,
-    /// Traversal of shadow and AO rays: packets with any-hit exit, or single rays.
+    /// Traversal of shadow and AO rays (and the path tracer's light samples): packets with
+    /// any-hit exit, single rays, or single rays over the 8-wide BVH.
     #[arg(long, value_enum, default_value_t = SecondaryArg::Packet)]
     pub secondary: SecondaryArg,
+    /// Traversal of the path tracer's bounced rays (camera rays always go in packets).
+    #[arg(long, value_enum, default_value_t = SecondaryArg::Wide)]
+    pub bounce_traversal: SecondaryArg,
     /// Volume: march every cell (no macrocell skipping), for comparison.
     #[arg(long)]
     pub no_macrocells: bool,
@@ -603,10 +619,8 @@ pub(crate) fn trace_options(args: &RenderArgs, modality: Modality) -> TraceOptio
         volume_shadows: args.volume_shadows,
         shadow_step_voxels: args.shadow_step,
         exposure: args.exposure,
-        secondary: match args.secondary {
-            SecondaryArg::Packet => SecondaryTraversal::Packet,
-            SecondaryArg::Single => SecondaryTraversal::Single,
-        },
+        secondary: args.secondary.into(),
+        bounces: args.bounce_traversal.into(),
     }
 }
 

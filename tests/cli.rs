@@ -150,8 +150,21 @@ fn render_modalities_write_pngs_and_refuse_what_is_missing() {
     let dir = std::env::temp_dir().join(format!("bnsview-modal-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let vol = ["--voxels-per-angstrom", "1"];
-    let cases: [&[&str]; 9] = [
+    let cases: [&[&str]; 11] = [
         &["--shadows"],
+        &["--ao", "2", "--secondary", "wide"],
+        &[
+            "--mode",
+            "path",
+            "--spp",
+            "1",
+            "--material",
+            "diffuse",
+            "--bounce-traversal",
+            "packet",
+            "--secondary",
+            "single",
+        ],
         &["--shadows", "--light-pos", "-5,40,0"],
         &["--ao", "2"],
         &["--mode", "path", "--spp", "2", "--material", "metal"],

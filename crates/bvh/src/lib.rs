@@ -1,6 +1,7 @@
 //! Ball-and-stick ray casting geometry (paper §4.1, §4.3): primitives, a binned SAH BVH built
 //! in parallel (plus the paper's full-sweep builder as a quality reference), SIMD intersection
-//! kernels generic over [`spmd::Simd`], coherent packet traversal and single-ray traversal.
+//! kernels generic over [`spmd::Simd`], coherent packet traversal, single-ray traversal and an 8-wide BVH for
+//! incoherent single rays.
 //!
 //! Units: lengths in Ångström (Å); ray directions are unit vectors, so `t` is in Å too.
 //!
@@ -19,6 +20,7 @@ mod intersect;
 pub mod scenes;
 mod traverse;
 mod tree;
+mod wide;
 
 pub use build::{BuildOptions, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
@@ -27,3 +29,4 @@ pub use intersect::{
 };
 pub use traverse::{load_packet, unpack_hits, Hit, PacketHit, Ray, RayPacket};
 pub use tree::{BuildStats, Builder, Bvh, Node, INNER, LEAF_MAX};
+pub use wide::{WideBvh, WideEntry, WideNode, WIDTH};

@@ -1,7 +1,7 @@
-//! Packet traversal against brute force, on every backend.
+//! Packet, single-ray and wide-BVH traversal against brute force, on every backend.
 
 use bvh::scenes::{random_molecule, Rng};
-use bvh::{Bvh, Geometry, Ray};
+use bvh::{Bvh, Geometry, Ray, WideBvh};
 use spmd::Isa;
 
 /// Rays from outside the scene towards random points inside it, plus rays starting inside.
@@ -101,7 +101,61 @@ fn compare(g: &Geometry, nrays: usize, seed: u64) {
                 "single ray {i}"
             );
         }
+        check_wide(g, &bvh, &rays, &reference, isa);
     }
+}
+
+/// The wide BVH finds the brute-force nearest hit (same leaf kernel, so the same `t` bit for
+/// bit; ties may pick the other primitive) and reports occlusion exactly where it hits.
+fn check_wide(g: &Geometry, bvh: &Bvh, rays: &[Ray], reference: &[Option<bvh::Hit>], isa: Isa) {
+    let wide = WideBvh::new(bvh);
+    wide.validate(bvh, g).unwrap();
+    let got = wide.intersect_rays(isa, bvh, rays);
+    let occ = wide.occluded_rays(isa, bvh, rays);
+    for (i, (r, (t, slot))) in reference.iter().zip(&got).enumerate() {
+        match r {
+            None => {
+                assert_eq!(
+                    *slot, -1,
+                    "{isa} wide ray {i}: hit at {t}, brute force misses"
+                );
+                assert_eq!(t.to_bits(), rays[i].tmax.to_bits(), "{isa} wide ray {i}");
+            }
+            Some(h) => {
+                assert!(
+                    *slot >= 0,
+                    "{isa} wide ray {i}: miss, brute force hits at {}",
+                    h.t
+                );
+                assert_eq!(*t, h.t, "{isa} wide ray {i}");
+            }
+        }
+        assert_eq!(
+            occ[i].1 == 1,
+            r.is_some(),
+            "{isa} wide occlusion of ray {i}"
+        );
+    }
+}
+
+#[test]
+fn wide_tree_of_tiny_and_one_leaf_scenes() {
+    for n in [1usize, 2, 5, 9, 40] {
+        let g = random_molecule(n, true, 20 + n as u64);
+        let bvh = Bvh::build(&g);
+        let rays = rays(&g, &bvh, 500, n as u64);
+        let reference = bvh.intersect_rays_brute(Isa::Scalar, &rays);
+        for isa in Isa::supported() {
+            check_wide(&g, &bvh, &rays, &reference, isa);
+        }
+    }
+    // Empty geometry: an empty tree that misses everything.
+    let g = Geometry::from_atoms(&[], &[], &[], &[], &[], &[], 0.15);
+    let bvh = Bvh::build(&g);
+    let wide = WideBvh::new(&bvh);
+    wide.validate(&bvh, &g).unwrap();
+    let r = Ray::new([0.0; 3], [0.0, 0.0, 1.0]);
+    assert_eq!(wide.intersect_rays(Isa::Scalar, &bvh, &[r])[0].1, -1);
 }
 
 #[test]
@@ -148,7 +202,10 @@ fn nan_and_inf_rays_do_not_panic() {
             });
         }
     }
+    let wide = WideBvh::new(&bvh);
     for isa in Isa::supported() {
         let _ = bvh.intersect_rays(isa, &rays);
+        let _ = wide.intersect_rays(isa, &bvh, &rays);
+        let _ = wide.occluded_rays(isa, &bvh, &rays);
     }
 }

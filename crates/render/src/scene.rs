@@ -1,6 +1,8 @@
 //! Scene assembly: styles, radii, colours, BVH.
 
-use bvh::{Bvh, Geometry, Prim};
+use std::sync::OnceLock;
+
+use bvh::{Bvh, Geometry, Prim, WideBvh};
 use rayon::prelude::*;
 
 use crate::colormap::Colormap;
@@ -72,6 +74,8 @@ pub struct Scene {
     pub center: [f32; 3],
     /// Radius of the bounding sphere (Å), including ball radii.
     pub radius: f32,
+    /// The 8-wide BVH for single incoherent rays, collapsed from `bvh` on first use.
+    wide: OnceLock<WideBvh>,
 }
 
 impl Scene {
@@ -192,6 +196,13 @@ impl Scene {
             slot_color_b,
             center,
             radius,
+            wide: OnceLock::new(),
         }
+    }
+
+    /// The 8-wide BVH of secondary rays ([`crate::SecondaryTraversal::Wide`]), built from
+    /// `bvh` the first time it is asked for (a few ms per million primitives).
+    pub fn wide(&self) -> &WideBvh {
+        self.wide.get_or_init(|| WideBvh::new(&self.bvh))
     }
 }

@@ -11,8 +11,10 @@
 //! ## Secondary rays
 //! Shadow and AO rays only need *whether* something is hit: [`occluded`] is a packet traversal
 //! with any-hit early exit (a lane that hits anything stops taking part in box tests; the
-//! packet stops when every lane has hit). Measured against tracing each lane alone on the
-//! scalar backend ([`SecondaryTraversal::Single`]): see [`SecondaryTraversal`].
+//! packet stops when every lane has hit). The path tracer's bounced rays go every which way;
+//! they are traced one at a time through the 8-wide BVH ([`bvh::WideBvh`]), which tests a
+//! node's eight child boxes in one SIMD op. Each ray kind can use either traversal (or the
+//! scalar single-ray one); the figures that chose the defaults are at [`SecondaryTraversal`].
 //!
 //! ## Random numbers
 //! Every random number is a pure function of (seed, pixel index, sample index, draw number):
@@ -30,7 +32,7 @@
 
 use std::time::Instant;
 
-use bvh::{intersect_record, surface, Bvh, PacketHit, RayPacket};
+use bvh::{intersect_record, surface, Bvh, PacketHit, Ray, RayPacket, WideEntry};
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Scalar, Simd, V3};
 use volume::{Light, VolumeScene};
@@ -80,18 +82,34 @@ pub enum Modality {
     },
 }
 
-/// How shadow and AO rays traverse the BVH.
+/// How secondary rays (shadow, AO, path bounces) traverse the BVH.
 ///
-/// Measured (ns90k, 1024², far view, 2 threads, AVX-512, one frame on a loaded machine):
-/// shadows 0.370 s packet vs 0.659 s single; AO 4 samples 0.903 s packet vs 1.887 s single.
-/// So `Packet` (any-hit, early exit) is the default for both ray kinds.
+/// Measured on ns90k, 1024², 2 threads, AVX2 (AMD EPYC, 2026-11-27), s per frame (path: per
+/// sample, metal, 6 hits), packet / single / wide:
+///
+/// | ray kind | far | close |
+/// |---|---|---|
+/// | shadow | 0.245 / 0.337 / 0.367 | 0.176 / 0.527 / 0.390 |
+/// | AO, 4 samples | 0.609 / 1.076 / 0.960 | 0.489 / 1.866 / 1.496 |
+/// | path bounces | 3.73 / 2.99 / 2.04 | 8.40 / 7.11 / 5.25 |
+///
+/// Shadow rays (all towards one light) and short AO rays from neighbouring pixels stay
+/// coherent, so packets win; bounced path rays do not, so the wide BVH wins (1.6-1.8×; on
+/// SSE4.1 1.3×, 3.39 vs 2.63 s; the scalar backend tests 8 boxes one at a time, 3.10 vs
+/// 3.33 s). Defaults: [`TraceOptions::secondary`] `Packet`, [`TraceOptions::bounces`] `Wide`.
+/// (Earlier, AVX-512 on a loaded machine: shadows 0.370 s packet vs 0.659 s single; AO 0.903
+/// vs 1.887 s.)
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SecondaryTraversal {
-    /// The incoherent rays of a pixel block as one packet, any-hit early exit.
+    /// The rays of a pixel block as one packet over the binary BVH (any-hit early exit for
+    /// shadow and AO rays).
     #[default]
     Packet,
-    /// Each lane alone through the scalar traversal (any-hit early exit).
+    /// Each lane alone through the binary BVH on the scalar backend.
     Single,
+    /// Each lane alone through the 8-wide BVH ([`Scene::wide`]), eight child boxes per SIMD
+    /// op.
+    Wide,
 }
 
 /// Options of the modalities.
@@ -119,6 +137,22 @@ pub struct TraceOptions {
     pub exposure: f32,
     /// Traversal of shadow and AO rays.
     pub secondary: SecondaryTraversal,
+    /// Traversal of the path tracer's bounced rays (primary rays always go in packets).
+    pub bounces: SecondaryTraversal,
+}
+
+impl TraceOptions {
+    /// Whether these options use the wide BVH (so it is built before the tiles start).
+    pub fn uses_wide(&self) -> bool {
+        match self.modality {
+            Modality::Direct { shadows } => shadows && self.secondary == SecondaryTraversal::Wide,
+            Modality::Ao { .. } => self.secondary == SecondaryTraversal::Wide,
+            Modality::Path { .. } => {
+                self.bounces == SecondaryTraversal::Wide
+                    || self.secondary == SecondaryTraversal::Wide
+            }
+        }
+    }
 }
 
 impl Default for TraceOptions {
@@ -134,6 +168,7 @@ impl Default for TraceOptions {
             shadow_step_voxels: 2.0,
             exposure: 1.0,
             secondary: SecondaryTraversal::Packet,
+            bounces: SecondaryTraversal::Wide,
         }
     }
 }
@@ -228,6 +263,9 @@ pub fn render_modal_into(
     let view = ViewRays::new(camera, w, h);
     let ntx = w.div_ceil(TILE);
     let first_sample = acc.samples;
+    if opt.uses_wide() {
+        scene.wide();
+    }
     if w > 0 && h > 0 && spp > 0 {
         acc.rgb
             .par_chunks_mut(3 * TILE * w)
@@ -309,7 +347,7 @@ pub fn ambient_occlusion_at(
 ) -> Vec<f32> {
     assert_eq!(points.len(), normals.len());
     isa.dispatch(AoAtKernel {
-        bvh: &scene.bvh,
+        scene,
         points,
         normals,
         samples,
@@ -320,7 +358,7 @@ pub fn ambient_occlusion_at(
 }
 
 struct AoAtKernel<'a> {
-    bvh: &'a Bvh,
+    scene: &'a Scene,
     points: &'a [[f32; 3]],
     normals: &'a [[f32; 3]],
     samples: u32,
@@ -334,7 +372,7 @@ impl Kernel for AoAtKernel<'_> {
     #[inline(always)]
     fn run<S: Simd>(self, s: S) -> Vec<f32> {
         let mut out = Vec::with_capacity(self.points.len());
-        let mut stack = vec![0u32; self.bvh.stack_size()];
+        let mut stack = Stacks::new(self.scene, false);
         let mut buf = [[0.0f32; spmd::MAX_LANES]; 6];
         let mut res = [0.0f32; spmd::MAX_LANES];
         for (c, (pts, nrm)) in self
@@ -361,7 +399,7 @@ impl Kernel for AoAtKernel<'_> {
             let mut rng = Rng::new(s, self.seed, pixel, 0);
             let ao = ao_factor(
                 s,
-                self.bvh,
+                self.scene,
                 SecondaryTraversal::Packet,
                 o,
                 n,
@@ -548,48 +586,129 @@ pub fn occluded<S: Simd>(s: S, bvh: &Bvh, ray: &RayPacket<S>, stack: &mut [u32])
     occ & ray.active
 }
 
-/// As [`occluded`], each active lane traced alone on the scalar backend.
-#[inline(always)]
-fn occluded_single<S: Simd>(s: S, bvh: &Bvh, ray: &RayPacket<S>, stack: &mut [u32]) -> S::M {
-    let bits = s.bitmask(ray.active);
-    let mut out = 0u32;
-    for i in 0..S::LANES {
-        if bits & (1 << i) == 0 {
-            continue;
+/// Traversal stacks of one task: the binary BVH's (packets and scalar single rays) and the
+/// wide BVH's (allocated only when the wide BVH is used).
+pub(crate) struct Stacks {
+    packet: Vec<u32>,
+    wide: Vec<WideEntry>,
+}
+
+impl Stacks {
+    fn new(scene: &Scene, wide: bool) -> Stacks {
+        Stacks {
+            packet: vec![0; scene.bvh.stack_size()],
+            wide: if wide {
+                vec![WideEntry::default(); scene.wide().stack_size()]
+            } else {
+                Vec::new()
+            },
         }
-        let r = RayPacket::<Scalar> {
-            o: V3::new(
-                s.extract(ray.o.x, i),
-                s.extract(ray.o.y, i),
-                s.extract(ray.o.z, i),
-            ),
-            d: V3::new(
-                s.extract(ray.d.x, i),
-                s.extract(ray.d.y, i),
-                s.extract(ray.d.z, i),
-            ),
-            tmin: s.extract(ray.tmin, i),
-            tmax: s.extract(ray.tmax, i),
-            active: true,
+    }
+}
+
+/// The active lanes of a packet as single rays (`n` of them, lane numbers in `lanes`).
+#[inline(always)]
+fn lanes_of<S: Simd>(
+    s: S,
+    ray: &RayPacket<S>,
+    rays: &mut [Ray; spmd::MAX_LANES],
+    lanes: &mut [usize; spmd::MAX_LANES],
+) -> usize {
+    let mut buf = [[0.0f32; spmd::MAX_LANES]; 8];
+    for (b, v) in buf.iter_mut().zip([
+        ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, ray.tmin, ray.tmax,
+    ]) {
+        s.store(v, b);
+    }
+    let mut bits = s.bitmask(ray.active);
+    let mut n = 0;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        rays[n] = Ray {
+            o: [buf[0][i], buf[1][i], buf[2][i]],
+            d: [buf[3][i], buf[4][i], buf[5][i]],
+            tmin: buf[6][i],
+            tmax: buf[7][i],
         };
-        if occluded(Scalar, bvh, &r, stack) {
+        lanes[n] = i;
+        n += 1;
+    }
+    n
+}
+
+/// One ray as a one-lane packet of the scalar backend.
+#[inline(always)]
+fn scalar_packet(r: &Ray) -> RayPacket<Scalar> {
+    RayPacket {
+        o: V3::new(r.o[0], r.o[1], r.o[2]),
+        d: V3::new(r.d[0], r.d[1], r.d[2]),
+        tmin: r.tmin,
+        tmax: r.tmax,
+        active: true,
+    }
+}
+
+/// Lanes of `ray` that hit anything in `(tmin, tmax)`, by the traversal `how`.
+#[inline(always)]
+fn occluded_by<S: Simd>(
+    s: S,
+    scene: &Scene,
+    how: SecondaryTraversal,
+    ray: &RayPacket<S>,
+    st: &mut Stacks,
+) -> S::M {
+    if how == SecondaryTraversal::Packet {
+        return occluded(s, &scene.bvh, ray, &mut st.packet);
+    }
+    let mut rays = [Ray::new([0.0; 3], [0.0, 0.0, 1.0]); spmd::MAX_LANES];
+    let mut lanes = [0usize; spmd::MAX_LANES];
+    let n = lanes_of(s, ray, &mut rays, &mut lanes);
+    let mut out = 0u32;
+    for (r, &i) in rays[..n].iter().zip(&lanes[..n]) {
+        let hit = if how == SecondaryTraversal::Wide {
+            scene.wide().occluded(s, &scene.bvh, r, &mut st.wide)
+        } else {
+            occluded(Scalar, &scene.bvh, &scalar_packet(r), &mut st.packet)
+        };
+        if hit {
             out |= 1 << i;
         }
     }
     s.mask_from_bits(out)
 }
 
+/// Nearest hits of `ray` by the traversal `how` (as [`Bvh::traverse_packet`]: `t` = tmax and
+/// slot −1 where nothing is hit).
 #[inline(always)]
-fn occluded_by<S: Simd>(
+fn closest_by<S: Simd>(
     s: S,
-    bvh: &Bvh,
+    scene: &Scene,
     how: SecondaryTraversal,
     ray: &RayPacket<S>,
-    stack: &mut [u32],
-) -> S::M {
-    match how {
-        SecondaryTraversal::Packet => occluded(s, bvh, ray, stack),
-        SecondaryTraversal::Single => occluded_single(s, bvh, ray, stack),
+    st: &mut Stacks,
+) -> PacketHit<S> {
+    if how == SecondaryTraversal::Packet {
+        return scene.bvh.traverse_packet(s, ray, &mut st.packet);
+    }
+    let mut rays = [Ray::new([0.0; 3], [0.0, 0.0, 1.0]); spmd::MAX_LANES];
+    let mut lanes = [0usize; spmd::MAX_LANES];
+    let n = lanes_of(s, ray, &mut rays, &mut lanes);
+    let mut tb = [f32::NEG_INFINITY; spmd::MAX_LANES];
+    let mut sb = [-1i32; spmd::MAX_LANES];
+    for (r, &i) in rays[..n].iter().zip(&lanes[..n]) {
+        (tb[i], sb[i]) = if how == SecondaryTraversal::Wide {
+            scene.wide().closest(s, &scene.bvh, r, &mut st.wide)
+        } else {
+            let h = scene
+                .bvh
+                .traverse_packet(Scalar, &scalar_packet(r), &mut st.packet);
+            (h.t, h.slot.0)
+        };
+    }
+    PacketHit {
+        t: s.load(&tb),
+        slot: s.load_i(&sb),
     }
 }
 
@@ -652,8 +771,36 @@ pub fn trace<S: Simd>(
     ray: &RayPacket<S>,
     stack: &mut [u32],
 ) -> Traced<S> {
+    let mut out = traced_none(s);
+    if let Some(sc) = scene {
+        let h = sc.bvh.traverse_packet(s, ray, stack);
+        out = hit_surface(s, sc, ray, h, out);
+    }
+    if let Some(vs) = volume {
+        let depth = s.select(out.mask, out.hit.t, s.splat(f32::INFINITY));
+        out.volume = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
+    }
+    out
+}
+
+/// [`trace`]'s opaque pass for secondary rays by the traversal `how` (no volume pass).
+#[inline(always)]
+fn trace_secondary<S: Simd>(
+    s: S,
+    scene: &Scene,
+    how: SecondaryTraversal,
+    ray: &RayPacket<S>,
+    st: &mut Stacks,
+) -> Traced<S> {
+    let h = closest_by(s, scene, how, ray, st);
+    hit_surface(s, scene, ray, h, traced_none(s))
+}
+
+/// A [`Traced`] with no hit and no volume.
+#[inline(always)]
+fn traced_none<S: Simd>(s: S) -> Traced<S> {
     let zero = s.splat(0.0);
-    let mut out = Traced {
+    Traced {
         hit: PacketHit {
             t: s.splat(f32::INFINITY),
             slot: s.splat_i(-1),
@@ -663,9 +810,20 @@ pub fn trace<S: Simd>(
         n: V3::splat(s, [0.0, 0.0, 1.0]),
         color: V3::splat(s, [0.0; 3]),
         volume: [zero; 4],
-    };
-    if let Some(sc) = scene {
-        let h = sc.bvh.traverse_packet(s, ray, stack);
+    }
+}
+
+/// Fills `out` with the hits `h` of `ray`: mask, point, normal facing the ray, atom colour.
+#[inline(always)]
+fn hit_surface<S: Simd>(
+    s: S,
+    sc: &Scene,
+    ray: &RayPacket<S>,
+    h: PacketHit<S>,
+    mut out: Traced<S>,
+) -> Traced<S> {
+    let zero = s.splat(0.0);
+    {
         let m = h.hit_mask(s) & ray.active;
         out.hit = h;
         out.mask = m;
@@ -684,10 +842,6 @@ pub fn trace<S: Simd>(
                 unit_channel(s, c, 16),
             );
         }
-    }
-    if let Some(vs) = volume {
-        let depth = s.select(out.mask, out.hit.t, s.splat(f32::INFINITY));
-        out.volume = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
     }
     out
 }
@@ -743,7 +897,7 @@ impl Kernel for ModalKernel<'_> {
 #[inline(always)]
 fn modal_tile<S: Simd>(s: S, k: ModalKernel<'_>) {
     let v = k.view;
-    let mut stack = vec![0u32; k.scene.bvh.stack_size()];
+    let mut stack = Stacks::new(k.scene, k.opt.uses_wide());
     let bw = block_width(S::LANES);
     let bh = S::LANES / bw;
     let mut lx = [0.0f32; spmd::MAX_LANES];
@@ -826,7 +980,7 @@ fn shade_sample<S: Simd>(
     k: &ModalKernel<'_>,
     ray: &RayPacket<S>,
     rng: &mut Rng<S>,
-    stack: &mut [u32],
+    st: &mut Stacks,
 ) -> V3<S> {
     let opt = k.opt;
     let bg = V3::splat(s, opt.background);
@@ -834,7 +988,7 @@ fn shade_sample<S: Simd>(
     let one = s.splat(1.0);
     match opt.modality {
         Modality::Direct { shadows } => {
-            let tr = trace(s, Some(k.scene), k.volume, ray, stack);
+            let tr = trace(s, Some(k.scene), k.volume, ray, &mut st.packet);
             let mut c = bg;
             if s.any(tr.mask) {
                 let o = spawn(s, &k.scene.bvh, &tr);
@@ -843,7 +997,7 @@ fn shade_sample<S: Simd>(
                 let lit = tr.mask & s.gt(ndl, zero);
                 let mut vis = s.select(lit, one, zero);
                 if shadows && s.any(lit) {
-                    vis = visibility(s, k, o, l, dist, lit, stack);
+                    vis = visibility(s, k, o, l, dist, lit, st);
                 }
                 let shade = s.splat(opt.ambient) + s.splat(opt.light_intensity) * ndl * vis;
                 c = V3::select(s, tr.mask, tr.color.scale(shade), bg);
@@ -851,13 +1005,13 @@ fn shade_sample<S: Simd>(
             over(s, tr.volume, c)
         }
         Modality::Ao { samples, distance } => {
-            let tr = trace(s, Some(k.scene), k.volume, ray, stack);
+            let tr = trace(s, Some(k.scene), k.volume, ray, &mut st.packet);
             let mut c = bg;
             if s.any(tr.mask) {
                 let o = spawn(s, &k.scene.bvh, &tr);
                 let ao = ao_factor(
                     s,
-                    &k.scene.bvh,
+                    k.scene,
                     opt.secondary,
                     o,
                     tr.n,
@@ -865,7 +1019,7 @@ fn shade_sample<S: Simd>(
                     samples,
                     distance,
                     rng,
-                    stack,
+                    st,
                 );
                 c = V3::select(s, tr.mask, tr.color.scale(ao), bg);
             }
@@ -880,8 +1034,13 @@ fn shade_sample<S: Simd>(
             let mut radiance = V3::splat(s, [0.0; 3]);
             let mut tp = V3::splat(s, [1.0; 3]);
             let mut r = *ray;
-            for _ in 0..max_depth.max(1) {
-                let tr = trace(s, Some(k.scene), None, &r, stack);
+            for depth in 0..max_depth.max(1) {
+                // Camera rays are coherent (packets); bounced rays use `opt.bounces`.
+                let tr = if depth == 0 {
+                    trace(s, Some(k.scene), None, &r, &mut st.packet)
+                } else {
+                    trace_secondary(s, k.scene, opt.bounces, &r, st)
+                };
                 let miss = r.active & !tr.mask;
                 radiance = V3::select(s, miss, radiance + tp * env, radiance);
                 let alive = tr.mask;
@@ -900,7 +1059,7 @@ fn shade_sample<S: Simd>(
                             let ndl = s.max(n.dot(l), zero);
                             let lit = alive & s.gt(ndl, zero);
                             if s.any(lit) {
-                                let vis = visibility(s, k, o, l, dist, lit, stack);
+                                let vis = visibility(s, k, o, l, dist, lit, st);
                                 let e = s.splat(opt.light_intensity) * ndl * vis;
                                 radiance =
                                     V3::select(s, lit, radiance + (tp * albedo).scale(e), radiance);
@@ -954,7 +1113,7 @@ fn visibility<S: Simd>(
     l: V3<S>,
     dist: S::F32,
     m: S::M,
-    stack: &mut [u32],
+    st: &mut Stacks,
 ) -> S::F32 {
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
@@ -965,7 +1124,7 @@ fn visibility<S: Simd>(
         tmax: dist,
         active: m,
     };
-    let occ = occluded_by(s, &k.scene.bvh, k.opt.secondary, &sray, stack);
+    let occ = occluded_by(s, k.scene, k.opt.secondary, &sray, st);
     let free = m & !occ;
     let mut vis = s.select(free, one, zero);
     if let (true, Some(vs)) = (k.opt.volume_shadows, k.volume) {
@@ -983,7 +1142,7 @@ fn visibility<S: Simd>(
 #[allow(clippy::too_many_arguments)]
 fn ao_factor<S: Simd>(
     s: S,
-    bvh: &Bvh,
+    scene: &Scene,
     how: SecondaryTraversal,
     o: V3<S>,
     n: V3<S>,
@@ -991,7 +1150,7 @@ fn ao_factor<S: Simd>(
     samples: u32,
     distance: f32,
     rng: &mut Rng<S>,
-    stack: &mut [u32],
+    st: &mut Stacks,
 ) -> S::F32 {
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
@@ -1006,7 +1165,7 @@ fn ao_factor<S: Simd>(
             tmax: s.splat(distance),
             active: m,
         };
-        let occ = occluded_by(s, bvh, how, &ray, stack);
+        let occ = occluded_by(s, scene, how, &ray, st);
         free += s.select(m & !occ, one, zero);
     }
     free * s.splat(1.0 / n_samples as f32)

@@ -85,7 +85,11 @@ fn check_shadow(light: Light, clearance: impl Fn([f64; 3]) -> Option<f64>) {
     let ambient = (0.2f32 * 255.0 + 0.5) as i32;
     let slab_prims = (scene.geometry.balls.len() - 1) as u32;
     for isa in Isa::under_test() {
-        for secondary in [SecondaryTraversal::Packet, SecondaryTraversal::Single] {
+        for secondary in [
+            SecondaryTraversal::Packet,
+            SecondaryTraversal::Single,
+            SecondaryTraversal::Wide,
+        ] {
             let opt = TraceOptions { secondary, ..opt };
             let (fb, _, _) = render_modal(&scene, None, &cam, w, h, &opt, 1, isa).unwrap();
             let (mut n_shadow, mut n_lit) = (0, 0);
@@ -425,9 +429,12 @@ fn every_backend_matches_scalar_for_a_fixed_seed() {
         ),
     ];
     for (modality, spp, need) in cases {
+        // The reference: scalar, every secondary ray in (one-lane) packets of the binary BVH.
         let opt = TraceOptions {
             modality,
             seed: 42,
+            secondary: SecondaryTraversal::Packet,
+            bounces: SecondaryTraversal::Packet,
             ..TraceOptions::default()
         };
         let (reference, _, _) =
@@ -440,13 +447,26 @@ fn every_backend_matches_scalar_for_a_fixed_seed() {
         // Same seed twice: identical; another seed: a different picture (AO/path).
         let (again, _, _) = render_modal(&scene, None, &cam, w, h, &opt, spp, Isa::Scalar).unwrap();
         assert_eq!(again, reference);
+        // Every backend and every traversal of the secondary rays (shadow, AO, bounces).
         for isa in Isa::under_test() {
-            let (fb, _, _) = render_modal(&scene, None, &cam, w, h, &opt, spp, isa).unwrap();
-            let (frac, mean) = compare(&reference, &fb, 2);
-            assert!(
-                frac >= need && mean < 0.5,
-                "{isa} {modality:?}: {frac} of pixels within 2/255 (need {need}), mean diff {mean}"
-            );
+            for how in [
+                SecondaryTraversal::Packet,
+                SecondaryTraversal::Single,
+                SecondaryTraversal::Wide,
+            ] {
+                let opt = TraceOptions {
+                    secondary: how,
+                    bounces: how,
+                    ..opt
+                };
+                let (fb, _, _) = render_modal(&scene, None, &cam, w, h, &opt, spp, isa).unwrap();
+                let (frac, mean) = compare(&reference, &fb, 2);
+                assert!(
+                    frac >= need && mean < 0.5,
+                    "{isa} {how:?} {modality:?}: {frac} of pixels within 2/255 (need {need}), \
+                     mean diff {mean}"
+                );
+            }
         }
     }
 }

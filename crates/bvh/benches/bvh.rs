@@ -1,10 +1,11 @@
-//! Kernel benchmarks per ISA: ray-sphere batches, coherent packet traversal, BVH builds.
-//! Ids: `ray_sphere/<isa>`, `packet_traversal/<isa>`, `bvh_build/<builder>`.
+//! Kernel benchmarks per ISA: ray-sphere batches, coherent packet traversal, incoherent rays
+//! (packets vs the wide BVH), BVH builds. Ids: `ray_sphere/<isa>`, `packet_traversal/<isa>`,
+//! `incoherent/{packet,wide}_<isa>`, `bvh_build/<builder>`.
 
 use std::hint::black_box;
 
 use bvh::scenes::{random_molecule, Rng};
-use bvh::{Bvh, Geometry, Ray};
+use bvh::{Bvh, Geometry, Ray, WideBvh};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use spmd::Isa;
 
@@ -72,6 +73,47 @@ fn packet_traversal(c: &mut Criterion) {
     grp.finish();
 }
 
+/// Rays like a path tracer's bounces: each from a random atom's surface in a random outward
+/// direction, so neighbouring rays (one packet) share little.
+fn incoherent_rays(g: &Geometry, n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let a = rng.below(g.balls.len());
+            let d = rng.dir();
+            let r = g.balls.radius[a] as f64 * 1.001;
+            let c = g.balls.center(a);
+            Ray::new(
+                [
+                    (c[0] as f64 + d[0] * r) as f32,
+                    (c[1] as f64 + d[1] * r) as f32,
+                    (c[2] as f64 + d[2] * r) as f32,
+                ],
+                [d[0] as f32, d[1] as f32, d[2] as f32],
+            )
+        })
+        .collect()
+}
+
+fn incoherent(c: &mut Criterion) {
+    let g = random_molecule(100_000, false, 7);
+    let bvh = Bvh::build(&g);
+    let wide = WideBvh::new(&bvh);
+    let rays = incoherent_rays(&g, 16_384, 3);
+    let mut grp = c.benchmark_group("incoherent");
+    grp.throughput(Throughput::Elements(rays.len() as u64));
+    grp.sample_size(20);
+    for isa in Isa::supported() {
+        grp.bench_function(format!("packet_{}", isa.name()), |b| {
+            b.iter(|| black_box(bvh.intersect_chunk(isa, black_box(&rays), false)))
+        });
+        grp.bench_function(format!("wide_{}", isa.name()), |b| {
+            b.iter(|| black_box(wide.intersect_rays(isa, &bvh, black_box(&rays))))
+        });
+    }
+    grp.finish();
+}
+
 fn bvh_build(c: &mut Criterion) {
     let g = random_molecule(100_000, false, 7);
     let mut grp = c.benchmark_group("bvh_build");
@@ -88,5 +130,5 @@ fn bvh_build(c: &mut Criterion) {
     grp.finish();
 }
 
-criterion_group!(benches, ray_sphere, packet_traversal, bvh_build);
+criterion_group!(benches, ray_sphere, packet_traversal, incoherent, bvh_build);
 criterion_main!(benches);

@@ -27,6 +27,8 @@ pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{
     end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,
 };
-pub use traverse::{load_packet, unpack_hits, Hit, PacketHit, Ray, RayPacket};
+pub use traverse::{
+    box_test, load_packet, slab_test, unpack_hits, Hit, PacketHit, Ray, RayPacket, BOX_GROW,
+};
 pub use tree::{BuildStats, Builder, Bvh, Node, INNER, LEAF_MAX};
 pub use wide::{WideBvh, WideEntry, WideNode, WIDTH};

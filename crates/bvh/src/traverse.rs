@@ -135,9 +135,7 @@ impl Bvh {
             // Inactive lanes get t = −∞ so no box test passes for them.
             hits[j].t = s.select(rays[j].active, rays[j].tmax, s.splat(f32::NEG_INFINITY));
         }
-        // Box exits are inflated by 1 + 2γ₃ (pbrt) so rounding never loses a box the ray hits.
-        let grow =
-            s.splat(1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5));
+        let grow = s.splat(BOX_GROW);
         let mut first = N;
         for j in (0..N).rev() {
             if s.any(rays[j].active) {
@@ -383,11 +381,48 @@ pub fn unpack_hits<S: Simd>(
     out
 }
 
-/// Ray–box slab test (§4.3 traversal) of one node against a packet: lanes whose ray enters the box before its current
-/// hit `t`. `min`/`max` drop a NaN first operand (0·∞ for a ray in a slab plane); the exit is
-/// inflated by `grow` so rounding never loses a box.
+/// Box exits are inflated by this factor, 1 + 2γ₃ (pbrt), so rounding never loses a box that
+/// a ray hits.
+pub const BOX_GROW: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// Ray–box slab test (§4.3 traversal), per lane: the ray `o + t·d` (`inv` = 1/d) against the
+/// box `lo..hi`; lanes may hold different rays (packets) or different boxes (one ray against a
+/// wide node's children). Returns the lanes whose ray enters the box in `[tmin, t]`, and the
+/// entry distances. `min`/`max` drop a NaN first operand (0·∞ for a ray in a slab plane); the
+/// exit is inflated by [`BOX_GROW`] (`grow` = its splat) so rounding never loses a box.
 #[inline(always)]
-fn box_test<S: Simd>(
+#[allow(clippy::too_many_arguments)]
+pub fn slab_test<S: Simd>(
+    s: S,
+    lo: V3<S>,
+    hi: V3<S>,
+    o: V3<S>,
+    inv: V3<S>,
+    tmin: S::F32,
+    t: S::F32,
+    grow: S::F32,
+) -> (S::M, S::F32) {
+    let tx0 = (lo.x - o.x) * inv.x;
+    let tx1 = (hi.x - o.x) * inv.x;
+    let ty0 = (lo.y - o.y) * inv.y;
+    let ty1 = (hi.y - o.y) * inv.y;
+    let tz0 = (lo.z - o.z) * inv.z;
+    let tz1 = (hi.z - o.z) * inv.z;
+    let entry = s.max(
+        s.min(tx0, tx1),
+        s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), tmin)),
+    );
+    let exit = s.min(
+        s.max(tx0, tx1),
+        s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), t)),
+    );
+    (s.le(entry, exit * grow) & s.le(entry, t), entry)
+}
+
+/// [`slab_test`] of one node against a packet: lanes whose ray enters the box before its
+/// current hit `t`.
+#[inline(always)]
+pub fn box_test<S: Simd>(
     s: S,
     node: &crate::tree::Node,
     ray: &RayPacket<S>,
@@ -395,20 +430,7 @@ fn box_test<S: Simd>(
     t: S::F32,
     grow: S::F32,
 ) -> S::M {
-    let o = ray.o;
-    let tx0 = (s.splat(node.min[0]) - o.x) * inv.x;
-    let tx1 = (s.splat(node.max[0]) - o.x) * inv.x;
-    let ty0 = (s.splat(node.min[1]) - o.y) * inv.y;
-    let ty1 = (s.splat(node.max[1]) - o.y) * inv.y;
-    let tz0 = (s.splat(node.min[2]) - o.z) * inv.z;
-    let tz1 = (s.splat(node.max[2]) - o.z) * inv.z;
-    let entry = s.max(
-        s.min(tx0, tx1),
-        s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), ray.tmin)),
-    );
-    let exit = s.min(
-        s.max(tx0, tx1),
-        s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), t)),
-    );
-    s.le(entry, exit * grow) & s.le(entry, t)
+    let lo = V3::splat(s, node.min);
+    let hi = V3::splat(s, node.max);
+    slab_test(s, lo, hi, ray.o, *inv, ray.tmin, t, grow).0
 }

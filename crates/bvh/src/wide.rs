@@ -11,7 +11,7 @@ use spmd::{Scalar, Simd, V3};
 
 use crate::geometry::{Aabb, Geometry};
 use crate::intersect::intersect_record;
-use crate::traverse::Ray;
+use crate::traverse::{slab_test, Ray, BOX_GROW};
 use crate::tree::Bvh;
 
 /// Children per wide node.
@@ -247,7 +247,7 @@ impl WideBvh {
         let records = &bvh.records[..];
         let o1 = V3::<Scalar>::new(ray.o[0], ray.o[1], ray.o[2]);
         let d1 = V3::<Scalar>::new(ray.d[0], ray.d[1], ray.d[2]);
-        // The same slab test as the packet traversal, the ray uniform and the boxes varying.
+        // The packet traversal's slab test, the ray uniform and the boxes varying.
         let o: V3<S> = V3::splat(s, ray.o);
         let inv: V3<S> = V3::new(
             s.rcp(s.splat(ray.d[0])),
@@ -255,8 +255,7 @@ impl WideBvh {
             s.rcp(s.splat(ray.d[2])),
         );
         let tmin = s.splat(ray.tmin);
-        let grow =
-            s.splat(1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5));
+        let grow = s.splat(BOX_GROW);
         let mut entry_buf = [0.0f32; spmd::MAX_LANES];
         let mut found = [WideEntry::default(); WIDTH];
         stack[0] = WideEntry {
@@ -298,27 +297,18 @@ impl WideBvh {
             let mut nf = 0usize;
             let mut c = 0usize;
             while c < n {
-                let mx = s.load_partial(&node.min[0][c..], 0.0);
-                let my = s.load_partial(&node.min[1][c..], 0.0);
-                let mz = s.load_partial(&node.min[2][c..], 0.0);
-                let xx = s.load_partial(&node.max[0][c..], 0.0);
-                let xy = s.load_partial(&node.max[1][c..], 0.0);
-                let xz = s.load_partial(&node.max[2][c..], 0.0);
-                let tx0 = (mx - o.x) * inv.x;
-                let tx1 = (xx - o.x) * inv.x;
-                let ty0 = (my - o.y) * inv.y;
-                let ty1 = (xy - o.y) * inv.y;
-                let tz0 = (mz - o.z) * inv.z;
-                let tz1 = (xz - o.z) * inv.z;
-                let entry = s.max(
-                    s.min(tx0, tx1),
-                    s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), tmin)),
+                let lo = V3::new(
+                    s.load_partial(&node.min[0][c..], 0.0),
+                    s.load_partial(&node.min[1][c..], 0.0),
+                    s.load_partial(&node.min[2][c..], 0.0),
                 );
-                let exit = s.min(
-                    s.max(tx0, tx1),
-                    s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), tv)),
+                let hi = V3::new(
+                    s.load_partial(&node.max[0][c..], 0.0),
+                    s.load_partial(&node.max[1][c..], 0.0),
+                    s.load_partial(&node.max[2][c..], 0.0),
                 );
-                let m = s.le(entry, exit * grow) & s.le(entry, tv) & s.first_n(n - c);
+                let (m, entry) = slab_test(s, lo, hi, o, inv, tmin, tv, grow);
+                let m = m & s.first_n(n - c);
                 let mut bits = s.bitmask(m);
                 if bits != 0 {
                     s.store(entry, &mut entry_buf);

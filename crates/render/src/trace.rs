@@ -32,7 +32,9 @@
 
 use std::time::Instant;
 
-use bvh::{intersect_record, surface, Bvh, PacketHit, Ray, RayPacket, WideEntry};
+use bvh::{
+    box_test, intersect_record, surface, Bvh, PacketHit, Ray, RayPacket, WideEntry, BOX_GROW,
+};
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Scalar, Simd, V3};
 use volume::{Light, VolumeScene};
@@ -527,7 +529,7 @@ pub fn occluded<S: Simd>(s: S, bvh: &Bvh, ray: &RayPacket<S>, stack: &mut [u32])
     let inv = V3::new(s.rcp(d.x), s.rcp(d.y), s.rcp(d.z));
     // Per-lane limit: tmax while searching, −∞ once occluded or inactive (no box passes).
     let mut t = s.select(ray.active, ray.tmax, neg_inf);
-    let grow = s.splat(1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5));
+    let grow = s.splat(BOX_GROW);
     let lane = s.bitmask(ray.active).trailing_zeros() as usize;
     let neg = [
         s.extract(d.x, lane) < 0.0,
@@ -710,34 +712,6 @@ fn closest_by<S: Simd>(
         t: s.load(&tb),
         slot: s.load_i(&sb),
     }
-}
-
-/// Slab test of a node (as the BVH's packet traversal: exit inflated by `grow`).
-#[inline(always)]
-fn box_test<S: Simd>(
-    s: S,
-    node: &bvh::Node,
-    ray: &RayPacket<S>,
-    inv: &V3<S>,
-    t: S::F32,
-    grow: S::F32,
-) -> S::M {
-    let o = ray.o;
-    let tx0 = (s.splat(node.min[0]) - o.x) * inv.x;
-    let tx1 = (s.splat(node.max[0]) - o.x) * inv.x;
-    let ty0 = (s.splat(node.min[1]) - o.y) * inv.y;
-    let ty1 = (s.splat(node.max[1]) - o.y) * inv.y;
-    let tz0 = (s.splat(node.min[2]) - o.z) * inv.z;
-    let tz1 = (s.splat(node.max[2]) - o.z) * inv.z;
-    let entry = s.max(
-        s.min(tx0, tx1),
-        s.max(s.min(ty0, ty1), s.max(s.min(tz0, tz1), ray.tmin)),
-    );
-    let exit = s.min(
-        s.max(tx0, tx1),
-        s.min(s.max(ty0, ty1), s.min(s.max(tz0, tz1), t)),
-    );
-    s.le(entry, exit * grow) & s.le(entry, t)
 }
 
 // ---------------------------------------------------------------------------------------

@@ -137,7 +137,7 @@ pub struct TraceOptions {
     pub shadow_step_voxels: f32,
     /// Path tracing: radiance multiplier before clamp and gamma.
     pub exposure: f32,
-    /// Traversal of shadow and AO rays.
+    /// Traversal of shadow and AO rays (and the path tracer's light samples).
     pub secondary: SecondaryTraversal,
     /// Traversal of the path tracer's bounced rays (primary rays always go in packets).
     pub bounces: SecondaryTraversal,
@@ -608,35 +608,60 @@ impl Stacks {
     }
 }
 
-/// The active lanes of a packet as single rays (`n` of them, lane numbers in `lanes`).
+/// Each active lane of `ray` traced alone by `how` (`Single`: the binary BVH on the scalar
+/// backend; `Wide`: the 8-wide BVH): per lane `(t, slot)`, slot −1 for a miss and for
+/// inactive lanes. `any`: stop at the first hit (slot ≥ 0 then only says "occluded").
 #[inline(always)]
-fn lanes_of<S: Simd>(
+fn single_rays<S: Simd>(
     s: S,
+    scene: &Scene,
+    how: SecondaryTraversal,
     ray: &RayPacket<S>,
-    rays: &mut [Ray; spmd::MAX_LANES],
-    lanes: &mut [usize; spmd::MAX_LANES],
-) -> usize {
+    st: &mut Stacks,
+    any: bool,
+) -> ([f32; spmd::MAX_LANES], [i32; spmd::MAX_LANES]) {
     let mut buf = [[0.0f32; spmd::MAX_LANES]; 8];
     for (b, v) in buf.iter_mut().zip([
         ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, ray.tmin, ray.tmax,
     ]) {
         s.store(v, b);
     }
+    let wide = if how == SecondaryTraversal::Wide {
+        Some(scene.wide())
+    } else {
+        None
+    };
+    let mut t = [f32::NEG_INFINITY; spmd::MAX_LANES];
+    let mut slot = [-1i32; spmd::MAX_LANES];
     let mut bits = s.bitmask(ray.active);
-    let mut n = 0;
     while bits != 0 {
         let i = bits.trailing_zeros() as usize;
         bits &= bits - 1;
-        rays[n] = Ray {
+        let r = Ray {
             o: [buf[0][i], buf[1][i], buf[2][i]],
             d: [buf[3][i], buf[4][i], buf[5][i]],
             tmin: buf[6][i],
             tmax: buf[7][i],
         };
-        lanes[n] = i;
-        n += 1;
+        (t[i], slot[i]) = match (wide, any) {
+            (Some(w), true) => (
+                r.tmax,
+                -i32::from(!w.occluded(s, &scene.bvh, &r, &mut st.wide)),
+            ),
+            (Some(w), false) => w.closest(s, &scene.bvh, &r, &mut st.wide),
+            (None, true) => {
+                let hit = occluded(Scalar, &scene.bvh, &scalar_packet(&r), &mut st.packet);
+                (r.tmax, -i32::from(!hit))
+            }
+            (None, false) => {
+                let h = scene
+                    .bvh
+                    .traverse_packet(Scalar, &scalar_packet(&r), &mut st.packet);
+                (h.t, h.slot.0)
+            }
+        };
     }
-    n
+    (t, slot)
 }
 
 /// One ray as a one-lane packet of the scalar backend.
@@ -663,25 +688,12 @@ fn occluded_by<S: Simd>(
     if how == SecondaryTraversal::Packet {
         return occluded(s, &scene.bvh, ray, &mut st.packet);
     }
-    let mut rays = [Ray::new([0.0; 3], [0.0, 0.0, 1.0]); spmd::MAX_LANES];
-    let mut lanes = [0usize; spmd::MAX_LANES];
-    let n = lanes_of(s, ray, &mut rays, &mut lanes);
-    let mut out = 0u32;
-    for (r, &i) in rays[..n].iter().zip(&lanes[..n]) {
-        let hit = if how == SecondaryTraversal::Wide {
-            scene.wide().occluded(s, &scene.bvh, r, &mut st.wide)
-        } else {
-            occluded(Scalar, &scene.bvh, &scalar_packet(r), &mut st.packet)
-        };
-        if hit {
-            out |= 1 << i;
-        }
-    }
-    s.mask_from_bits(out)
+    let (_, slot) = single_rays(s, scene, how, ray, st, true);
+    s.gt_i(s.load_i(&slot), s.splat_i(-1))
 }
 
-/// Nearest hits of `ray` by the traversal `how` (as [`Bvh::traverse_packet`]: `t` = tmax and
-/// slot −1 where nothing is hit).
+/// Nearest hits of `ray` by the traversal `how` (as [`Bvh::traverse_packet`]: slot −1 where
+/// nothing is hit).
 #[inline(always)]
 fn closest_by<S: Simd>(
     s: S,
@@ -693,24 +705,10 @@ fn closest_by<S: Simd>(
     if how == SecondaryTraversal::Packet {
         return scene.bvh.traverse_packet(s, ray, &mut st.packet);
     }
-    let mut rays = [Ray::new([0.0; 3], [0.0, 0.0, 1.0]); spmd::MAX_LANES];
-    let mut lanes = [0usize; spmd::MAX_LANES];
-    let n = lanes_of(s, ray, &mut rays, &mut lanes);
-    let mut tb = [f32::NEG_INFINITY; spmd::MAX_LANES];
-    let mut sb = [-1i32; spmd::MAX_LANES];
-    for (r, &i) in rays[..n].iter().zip(&lanes[..n]) {
-        (tb[i], sb[i]) = if how == SecondaryTraversal::Wide {
-            scene.wide().closest(s, &scene.bvh, r, &mut st.wide)
-        } else {
-            let h = scene
-                .bvh
-                .traverse_packet(Scalar, &scalar_packet(r), &mut st.packet);
-            (h.t, h.slot.0)
-        };
-    }
+    let (t, slot) = single_rays(s, scene, how, ray, st, false);
     PacketHit {
-        t: s.load(&tb),
-        slot: s.load_i(&sb),
+        t: s.load(&t),
+        slot: s.load_i(&slot),
     }
 }
 
@@ -745,11 +743,10 @@ pub fn trace<S: Simd>(
     ray: &RayPacket<S>,
     stack: &mut [u32],
 ) -> Traced<S> {
-    let mut out = traced_none(s);
-    if let Some(sc) = scene {
-        let h = sc.bvh.traverse_packet(s, ray, stack);
-        out = hit_surface(s, sc, ray, h, out);
-    }
+    let mut out = match scene {
+        Some(sc) => hit_surface(s, sc, ray, sc.bvh.traverse_packet(s, ray, stack)),
+        None => traced_none(s),
+    };
     if let Some(vs) = volume {
         let depth = s.select(out.mask, out.hit.t, s.splat(f32::INFINITY));
         out.volume = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
@@ -766,8 +763,7 @@ fn trace_secondary<S: Simd>(
     ray: &RayPacket<S>,
     st: &mut Stacks,
 ) -> Traced<S> {
-    let h = closest_by(s, scene, how, ray, st);
-    hit_surface(s, scene, ray, h, traced_none(s))
+    hit_surface(s, scene, ray, closest_by(s, scene, how, ray, st))
 }
 
 /// A [`Traced`] with no hit and no volume.
@@ -787,35 +783,29 @@ fn traced_none<S: Simd>(s: S) -> Traced<S> {
     }
 }
 
-/// Fills `out` with the hits `h` of `ray`: mask, point, normal facing the ray, atom colour.
+/// The opaque pass's result for the hits `h` of `ray`: mask, point, normal facing the ray,
+/// atom colour (no volume).
 #[inline(always)]
-fn hit_surface<S: Simd>(
-    s: S,
-    sc: &Scene,
-    ray: &RayPacket<S>,
-    h: PacketHit<S>,
-    mut out: Traced<S>,
-) -> Traced<S> {
+fn hit_surface<S: Simd>(s: S, sc: &Scene, ray: &RayPacket<S>, h: PacketHit<S>) -> Traced<S> {
     let zero = s.splat(0.0);
-    {
-        let m = h.hit_mask(s) & ray.active;
-        out.hit = h;
-        out.mask = m;
-        if s.any(m) {
-            let srf = surface(s, &sc.bvh.records, ray.o, ray.d, h.t, h.slot, m);
-            let flip = s.gt(srf.n.dot(ray.d), zero);
-            out.n = V3::select(s, flip, -srf.n, srf.n);
-            out.p = ray.o.mul_add(ray.d, h.t);
-            let zi = s.splat_i(0);
-            let ca = s.gather_i(&sc.slot_color_a, h.slot, m, zi);
-            let cb = s.gather_i(&sc.slot_color_b, h.slot, m, zi);
-            let c = s.select_i(srf.second_half, cb, ca);
-            out.color = V3::new(
-                unit_channel(s, c, 0),
-                unit_channel(s, c, 8),
-                unit_channel(s, c, 16),
-            );
-        }
+    let mut out = traced_none(s);
+    let m = h.hit_mask(s) & ray.active;
+    out.hit = h;
+    out.mask = m;
+    if s.any(m) {
+        let srf = surface(s, &sc.bvh.records, ray.o, ray.d, h.t, h.slot, m);
+        let flip = s.gt(srf.n.dot(ray.d), zero);
+        out.n = V3::select(s, flip, -srf.n, srf.n);
+        out.p = ray.o.mul_add(ray.d, h.t);
+        let zi = s.splat_i(0);
+        let ca = s.gather_i(&sc.slot_color_a, h.slot, m, zi);
+        let cb = s.gather_i(&sc.slot_color_b, h.slot, m, zi);
+        let c = s.select_i(srf.second_half, cb, ca);
+        out.color = V3::new(
+            unit_channel(s, c, 0),
+            unit_channel(s, c, 8),
+            unit_channel(s, c, 16),
+        );
     }
     out
 }

@@ -14,7 +14,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use molecule::scenes::SceneName;
 use render::{
-    render_frame_into, render_modal_into, Accum, Camera, Framebuffer, RenderOptions, Scene,
+    render_frame_into, render_modal_into, Accum, Camera, Framebuffer, Model, RenderOptions,
     TraceOptions, View,
 };
 use serde_json::{json, Value};
@@ -282,7 +282,7 @@ pub struct BenchArgs {
     /// Atoms per scene (overrides the paper's count and --quick).
     #[arg(long)]
     pub atoms: Option<usize>,
-    /// Scene random seed.
+    /// Model random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Transfer function of the volume modes (preset or control-point file).
@@ -673,7 +673,7 @@ impl Preprocess {
 /// Bytes of the ball-and-stick geometry (balls, sticks, the kernels' primitive records and
 /// per-slot colours) and of the BVH proper (nodes and slot → primitive ids), the split of the
 /// paper's "geometry size" and "BVH size".
-fn scene_bytes(s: &Scene) -> (u64, u64) {
+fn scene_bytes(s: &Model) -> (u64, u64) {
     let b = &s.geometry.balls;
     let geometry = std::mem::size_of_val(&b.x[..])
         + std::mem::size_of_val(&b.y[..])
@@ -729,7 +729,7 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// Bounding sphere of the balls, as [`Scene::new`] computes it (centre of the box, radius to
+/// Bounding sphere of the balls, as [`Model::new`] computes it (centre of the box, radius to
 /// the farthest ball surface), for runs that build no BVH.
 fn atoms_sphere(m: &molecule::Molecule, g: &GeometryArgs) -> ([f32; 3], f32) {
     if m.is_empty() {
@@ -1279,14 +1279,14 @@ enum Renderer<'a> {
     /// `render_frame_into`: headlight b&s, volume, vol+b&s (as `bnsview render` without
     /// modality flags).
     Frame {
-        geo: Option<&'a Scene>,
+        geo: Option<&'a Model>,
         vol: Option<&'a VolumeScene<'a>>,
         fb: Framebuffer,
         opt: RenderOptions,
     },
     /// `render_modal_into` with the trace options of the mode's `bnsview render` flags.
     Modal {
-        scene: &'a Scene,
+        scene: &'a Model,
         vol: Option<&'a VolumeScene<'a>>,
         acc: Accum,
         opt: TraceOptions,
@@ -1297,7 +1297,7 @@ enum Renderer<'a> {
 impl<'a> Renderer<'a> {
     fn new(
         key: &Key,
-        geo: Option<&'a Scene>,
+        geo: Option<&'a Model>,
         vol: Option<&'a VolumeScene<'a>>,
     ) -> Result<Renderer<'a>> {
         let Some(flags) = key.mode.render_flags() else {
@@ -1824,7 +1824,7 @@ mod tests {
 
     #[test]
     fn volume_only_runs_see_the_same_frame_as_geometry_runs() {
-        // The camera of a volume-only run (no BVH) is fitted to the same sphere as Scene's.
+        // The camera of a volume-only run (no BVH) is fitted to the same sphere as Model's.
         let m = molecule::scenes::generate(SceneName::Ns90k, Some(3000), 7);
         let bonds = molecule::bonds::build_bonds(&m, &Default::default());
         let g = args(&[]).geometry;

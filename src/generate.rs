@@ -12,7 +12,7 @@ use std::time::Instant;
 /// Arguments of `bnsview generate`.
 #[derive(Args, Debug)]
 pub struct GenerateArgs {
-    /// Scene: nanobowl, ns90k, ns740k, sio2, anp3.
+    /// Model: nanobowl, ns90k, ns740k, sio2, anp3.
     pub scene: SceneName,
     /// Approximate number of atoms (default: the paper's count for the scene).
     #[arg(long)]

@@ -32,10 +32,10 @@ pub struct InputArgs {
     /// Built-in scene instead of a file: nanobowl, ns90k, ns740k, sio2, anp3.
     #[arg(long)]
     pub scene: Option<SceneName>,
-    /// Scene size in atoms (default: the paper's count).
+    /// Model size in atoms (default: the paper's count).
     #[arg(long, requires = "scene")]
     pub atoms: Option<usize>,
-    /// Scene random seed.
+    /// Model random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// File format (default: from the extension or content).

@@ -8,7 +8,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use molecule::elements;
 use molecule::Molecule;
-use render::{Coloring, Colormap, Scene, SceneOptions, Style};
+use render::{Coloring, Colormap, Model, ModelOptions, Style};
 use spmd::Isa;
 use volume::{build_density, DensityParams, Macrocells, Volume, VolumeFormat};
 
@@ -77,7 +77,7 @@ pub fn build_scene(
     m: &Molecule,
     bonds: &[[u32; 2]],
     g: &GeometryArgs,
-) -> anyhow::Result<(Scene, f64)> {
+) -> anyhow::Result<(Model, f64)> {
     let t = Instant::now();
     let radius: Vec<f32> = m
         .elements
@@ -130,7 +130,7 @@ pub fn build_scene(
             g.stick_radius
         );
     }
-    let opt = SceneOptions {
+    let opt = ModelOptions {
         radius_scale: g.radius_scale,
         stick_radius: g.stick_radius,
         style: match g.style {
@@ -140,7 +140,7 @@ pub fn build_scene(
         },
         coloring,
     };
-    let scene = Scene::new(&m.x, &m.y, &m.z, &radius, &colors, bonds, &opt);
+    let scene = Model::new(&m.x, &m.y, &m.z, &radius, &colors, bonds, &opt);
     Ok((scene, t.elapsed().as_secs_f64()))
 }
 

@@ -5,11 +5,11 @@ use std::hint::black_box;
 
 use bvh::scenes::random_molecule;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use render::{render_bs_into, Camera, Framebuffer, RenderOptions, Scene, View};
+use render::{render_bs_into, Camera, Framebuffer, Model, RenderOptions, View};
 use spmd::Isa;
 
 fn render(c: &mut Criterion) {
-    let scene = Scene::from_geometry(random_molecule(100_000, false, 7));
+    let scene = Model::from_geometry(random_molecule(100_000, false, 7));
     let cam = Camera::view(View::Far, scene.center, scene.radius, 45.0, 1.0);
     let mut fb = Framebuffer::new(512, 512, 0).unwrap();
     let ro = RenderOptions::default();

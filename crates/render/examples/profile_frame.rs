@@ -1,6 +1,6 @@
 //! Renders frames in a loop for profiling: `profile_frame [atoms] [frames] [isa] [regs]`.
 use bvh::scenes::random_molecule;
-use render::{render_bs_into, Camera, Framebuffer, RenderOptions, Scene, View};
+use render::{render_bs_into, Camera, Framebuffer, Model, RenderOptions, View};
 use spmd::Isa;
 
 fn main() {
@@ -15,7 +15,7 @@ fn main() {
         Some(r) => vec![r.parse().unwrap()],
         None => vec![1, 2, 4],
     };
-    let scene = Scene::from_geometry(random_molecule(atoms, false, 7));
+    let scene = Model::from_geometry(random_molecule(atoms, false, 7));
     let mut fb = Framebuffer::new(1024, 1024, 0).unwrap();
     // Configurations are interleaved frame by frame so load from other processes hits them
     // alike; min and median per configuration.

@@ -5,25 +5,17 @@
 //!
 //! Units: positions and radii in Ångström (Å); field of view in degrees.
 
-mod camera;
-mod colormap;
 mod framebuffer;
-mod scene;
 mod tile;
 mod trace;
 
-pub use camera::{Camera, Projection, View};
-pub use colormap::{viridis, Colormap};
 pub use framebuffer::{Framebuffer, RenderError};
-pub use scene::{Coloring, Scene, SceneOptions, Style};
+pub use scene::{
+    rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
+};
 pub use tile::{render_bs, render_bs_into, render_frame_into, RenderOptions, RenderStats, TILE};
 pub use trace::{
     ambient_occlusion_at, occluded, render_modal, render_modal_into, trace, Accum, Material,
     Modality, SecondaryTraversal, TraceOptions, Traced,
 };
 pub use volume::Light;
-
-/// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
-pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {
-    r as u32 | (g as u32) << 8 | (b as u32) << 16 | (a as u32) << 24
-}

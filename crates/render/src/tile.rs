@@ -7,9 +7,8 @@ use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd, V3};
 use volume::VolumeScene;
 
-use crate::camera::{Camera, Projection};
 use crate::framebuffer::{Framebuffer, RenderError};
-use crate::scene::Scene;
+use scene::{Camera, Model, Projection};
 
 /// Tile edge in pixels (tiles are the rayon tasks).
 pub const TILE: usize = 16;
@@ -60,7 +59,7 @@ impl RenderStats {
 /// Renders `scene` as seen by `camera` into a new `width × height` frame: one primary ray per
 /// pixel, headlight diffuse shading. `isa` must be supported (see [`Isa::select`]).
 pub fn render_bs(
-    scene: &Scene,
+    scene: &Model,
     camera: &Camera,
     width: u32,
     height: u32,
@@ -77,7 +76,7 @@ pub fn render_bs(
 /// marched from the eye up to the opaque hit and composited in front of it
 /// (`volume` alone: the paper's "volume" mode; both: "vol+b&s").
 pub fn render_frame_into(
-    scene: Option<&Scene>,
+    scene: Option<&Model>,
     volume: Option<&VolumeScene>,
     camera: &Camera,
     fb: &mut Framebuffer,
@@ -89,7 +88,7 @@ pub fn render_frame_into(
 
 /// As [`render_bs`] into an existing frame (reuse it across frames).
 pub fn render_bs_into(
-    scene: &Scene,
+    scene: &Model,
     camera: &Camera,
     fb: &mut Framebuffer,
     opt: &RenderOptions,
@@ -100,7 +99,7 @@ pub fn render_bs_into(
 
 /// The tile loop shared by every mode.
 fn render_tiles(
-    scene: Option<&Scene>,
+    scene: Option<&Model>,
     volume: Option<&VolumeScene>,
     camera: &Camera,
     fb: &mut Framebuffer,
@@ -205,7 +204,7 @@ impl ViewRays {
 }
 
 struct TileKernel<'a> {
-    scene: Option<&'a Scene>,
+    scene: Option<&'a Model>,
     volume: Option<&'a VolumeScene<'a>>,
     view: &'a ViewRays,
     opt: &'a RenderOptions,
@@ -354,7 +353,7 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &mut TileKernel<'_>) {
 #[inline(always)]
 fn shade_bs<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     opt: &RenderOptions,
     ray: &RayPacket<S>,
     hit: &bvh::PacketHit<S>,

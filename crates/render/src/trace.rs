@@ -39,10 +39,10 @@ use rayon::prelude::*;
 use spmd::{Isa, Kernel, Scalar, Simd, V3};
 use volume::{Light, VolumeScene};
 
-use crate::camera::Camera;
 use crate::framebuffer::{Framebuffer, RenderError};
-use crate::scene::Scene;
 use crate::tile::{block_width, RenderStats, ViewRays, TILE};
+use scene::Camera;
+use scene::Model;
 
 /// BRDF of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,7 +109,7 @@ pub enum SecondaryTraversal {
     Packet,
     /// Each lane alone through the binary BVH on the scalar backend.
     Single,
-    /// Each lane alone through the 8-wide BVH ([`Scene::wide`]), eight child boxes per SIMD
+    /// Each lane alone through the 8-wide BVH ([`Model::wide`]), eight child boxes per SIMD
     /// op.
     Wide,
 }
@@ -252,7 +252,7 @@ impl Accum {
 /// shadow rays when `opt.volume_shadows`; the path tracer ignores it for primary rays.
 #[allow(clippy::too_many_arguments)]
 pub fn render_modal_into(
-    scene: &Scene,
+    scene: &Model,
     volume: Option<&VolumeScene>,
     camera: &Camera,
     acc: &mut Accum,
@@ -317,7 +317,7 @@ pub fn render_modal_into(
 /// Convenience: a new accumulation of `spp` samples, tone mapped to a frame.
 #[allow(clippy::too_many_arguments)]
 pub fn render_modal(
-    scene: &Scene,
+    scene: &Model,
     volume: Option<&VolumeScene>,
     camera: &Camera,
     width: u32,
@@ -338,7 +338,7 @@ pub fn render_modal(
 /// the point index as the pixel index. For tests and tools.
 #[allow(clippy::too_many_arguments)]
 pub fn ambient_occlusion_at(
-    scene: &Scene,
+    scene: &Model,
     points: &[[f32; 3]],
     normals: &[[f32; 3]],
     samples: u32,
@@ -360,7 +360,7 @@ pub fn ambient_occlusion_at(
 }
 
 struct AoAtKernel<'a> {
-    scene: &'a Scene,
+    scene: &'a Model,
     points: &'a [[f32; 3]],
     normals: &'a [[f32; 3]],
     samples: u32,
@@ -596,7 +596,7 @@ pub(crate) struct Stacks {
 }
 
 impl Stacks {
-    fn new(scene: &Scene, wide: bool) -> Stacks {
+    fn new(scene: &Model, wide: bool) -> Stacks {
         Stacks {
             packet: vec![0; scene.bvh.stack_size()],
             wide: if wide {
@@ -614,7 +614,7 @@ impl Stacks {
 #[inline(always)]
 fn single_rays<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     how: SecondaryTraversal,
     ray: &RayPacket<S>,
     st: &mut Stacks,
@@ -680,7 +680,7 @@ fn scalar_packet(r: &Ray) -> RayPacket<Scalar> {
 #[inline(always)]
 fn occluded_by<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     how: SecondaryTraversal,
     ray: &RayPacket<S>,
     st: &mut Stacks,
@@ -697,7 +697,7 @@ fn occluded_by<S: Simd>(
 #[inline(always)]
 fn closest_by<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     how: SecondaryTraversal,
     ray: &RayPacket<S>,
     st: &mut Stacks,
@@ -738,7 +738,7 @@ pub struct Traced<S: Simd> {
 #[inline(always)]
 pub fn trace<S: Simd>(
     s: S,
-    scene: Option<&Scene>,
+    scene: Option<&Model>,
     volume: Option<&VolumeScene>,
     ray: &RayPacket<S>,
     stack: &mut [u32],
@@ -758,7 +758,7 @@ pub fn trace<S: Simd>(
 #[inline(always)]
 fn trace_secondary<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     how: SecondaryTraversal,
     ray: &RayPacket<S>,
     st: &mut Stacks,
@@ -786,7 +786,7 @@ fn traced_none<S: Simd>(s: S) -> Traced<S> {
 /// The opaque pass's result for the hits `h` of `ray`: mask, point, normal facing the ray,
 /// atom colour (no volume).
 #[inline(always)]
-fn hit_surface<S: Simd>(s: S, sc: &Scene, ray: &RayPacket<S>, h: PacketHit<S>) -> Traced<S> {
+fn hit_surface<S: Simd>(s: S, sc: &Model, ray: &RayPacket<S>, h: PacketHit<S>) -> Traced<S> {
     let zero = s.splat(0.0);
     let mut out = traced_none(s);
     let m = h.hit_mask(s) & ray.active;
@@ -838,7 +838,7 @@ fn spawn<S: Simd>(s: S, bvh: &Bvh, tr: &Traced<S>) -> V3<S> {
 // Tile kernel
 
 struct ModalKernel<'a> {
-    scene: &'a Scene,
+    scene: &'a Model,
     volume: Option<&'a VolumeScene<'a>>,
     view: &'a ViewRays,
     opt: &'a TraceOptions,
@@ -1106,7 +1106,7 @@ fn visibility<S: Simd>(
 #[allow(clippy::too_many_arguments)]
 fn ao_factor<S: Simd>(
     s: S,
-    scene: &Scene,
+    scene: &Model,
     how: SecondaryTraversal,
     o: V3<S>,
     n: V3<S>,

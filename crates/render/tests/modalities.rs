@@ -6,13 +6,13 @@ use bvh::scenes::random_molecule;
 use bvh::{Balls, Geometry, Ray, Sticks};
 use render::{
     ambient_occlusion_at, render_modal, rgba, Camera, Framebuffer, Light, Material, Modality,
-    Scene, SecondaryTraversal, TraceOptions, View,
+    Model, SecondaryTraversal, TraceOptions, View,
 };
 use spmd::Isa;
 
 const WHITE: u32 = rgba(255, 255, 255, 255);
 
-fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Scene {
+fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Model {
     let g = Geometry {
         balls: Balls {
             x: centres.iter().map(|c| c[0]).collect(),
@@ -29,14 +29,14 @@ fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Scene {
         show_balls: true,
         capped: false,
     };
-    Scene::from_geometry(g)
+    Model::from_geometry(g)
 }
 
 /// A 21×21 slab of overlapping unit balls in the plane y = 0 (spacing 1 Å, so its top is a
 /// height field) and a ball of radius `R` centred `(0, H, 0)` above it.
 const R: f64 = 2.0;
 const H: f32 = 5.0;
-fn sphere_over_slab() -> Scene {
+fn sphere_over_slab() -> Model {
     let mut c = Vec::new();
     for i in -10..=10 {
         for k in -10..=10 {
@@ -346,7 +346,7 @@ fn single_ball_under_white_sky_returns_its_albedo() {
     }
 }
 
-fn molecule_scene() -> Scene {
+fn molecule_scene() -> Model {
     let g = random_molecule(3_000, true, 21);
     let pairs: Vec<[u32; 2]> = g
         .sticks
@@ -355,14 +355,14 @@ fn molecule_scene() -> Scene {
         .zip(&g.sticks.b)
         .map(|(&a, &b)| [a, b])
         .collect();
-    Scene::new(
+    Model::new(
         &g.balls.x,
         &g.balls.y,
         &g.balls.z,
         &g.balls.radius,
         &g.balls.color,
         &pairs,
-        &render::SceneOptions::default(),
+        &render::ModelOptions::default(),
     )
 }
 

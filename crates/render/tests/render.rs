@@ -3,7 +3,7 @@
 use bvh::scenes::random_molecule;
 use bvh::{Balls, Geometry, Ray, Sticks};
 use render::{
-    render_bs, rgba, Camera, Coloring, Colormap, Framebuffer, RenderOptions, Scene, SceneOptions,
+    render_bs, rgba, Camera, Coloring, Colormap, Framebuffer, Model, ModelOptions, RenderOptions,
     Style, View,
 };
 use spmd::Isa;
@@ -28,12 +28,12 @@ fn every_backend_matches_scalar() {
     for style in [Style::BallAndStick, Style::Licorice, Style::Spheres] {
         let g = random_molecule(3_000, true, 21);
         let radius_scale = if style == Style::Spheres { 2.0 } else { 0.5 };
-        let opt = SceneOptions {
+        let opt = ModelOptions {
             style,
             radius_scale,
             ..Default::default()
         };
-        let scene = Scene::new(
+        let scene = Model::new(
             &g.balls.x,
             &g.balls.y,
             &g.balls.z,
@@ -82,7 +82,7 @@ fn pairs(g: &Geometry) -> Vec<[u32; 2]> {
 
 /// Unit sphere at the origin (atom 0); an open cylinder of radius 0.5 from (3,−2,0) to (3,2,0)
 /// (atoms 1 and 2 have radius 0, so they never show).
-fn sphere_and_cylinder() -> Scene {
+fn sphere_and_cylinder() -> Model {
     let g = Geometry {
         balls: Balls {
             x: vec![0.0, 3.0, 3.0],
@@ -103,7 +103,7 @@ fn sphere_and_cylinder() -> Scene {
         show_balls: true,
         capped: false,
     };
-    Scene::from_geometry(g)
+    Model::from_geometry(g)
 }
 
 #[test]
@@ -211,7 +211,7 @@ fn analytic_shading_orthographic() {
 fn scalar_colormap_and_png() {
     let g = random_molecule(500, false, 3);
     let values: Vec<f32> = (0..500).map(|i| i as f32).collect();
-    let opt = SceneOptions {
+    let opt = ModelOptions {
         coloring: Coloring::Scalar {
             values,
             colormap: Colormap::Viridis,
@@ -219,7 +219,7 @@ fn scalar_colormap_and_png() {
         },
         ..Default::default()
     };
-    let scene = Scene::new(
+    let scene = Model::new(
         &g.balls.x,
         &g.balls.y,
         &g.balls.z,

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use render::{render_bs, rgba, Camera, RenderOptions, Scene, SceneOptions, Style, View};
+use render::{render_bs, rgba, Camera, Model, ModelOptions, RenderOptions, Style, View};
 use spmd::Isa;
 
 fn sample(name: &str) -> PathBuf {
@@ -88,12 +88,12 @@ fn protein_renders_alike_on_every_backend() {
         bonds.len()
     );
     for style in [Style::BallAndStick, Style::Licorice, Style::Spheres] {
-        let opt = SceneOptions {
+        let opt = ModelOptions {
             style,
             radius_scale: if style == Style::Spheres { 2.0 } else { 0.5 },
             ..Default::default()
         };
-        let scene = Scene::new(
+        let scene = Model::new(
             &atoms.x,
             &atoms.y,
             &atoms.z,

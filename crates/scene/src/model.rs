@@ -1,4 +1,4 @@
-//! Scene assembly: styles, radii, colours, BVH.
+//! Model assembly: styles, radii, colours, BVH.
 
 use std::sync::OnceLock;
 
@@ -21,7 +21,7 @@ pub enum Style {
 /// How atoms are coloured.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Coloring {
-    /// The per-atom colours passed to [`Scene::new`] (e.g. CPK by element).
+    /// The per-atom colours passed to [`Model::new`] (e.g. CPK by element).
     PerAtom,
     /// A per-atom scalar mapped through a colormap; `range` = values mapped to 0 and 1
     /// (`None`: the finite min and max of the values).
@@ -37,7 +37,7 @@ pub enum Coloring {
 
 /// Geometry options (they decide what the BVH is built over).
 #[derive(Clone, Debug, PartialEq)]
-pub struct SceneOptions {
+pub struct ModelOptions {
     /// Ball radius = per-atom radius × this (e.g. 0.5 with covalent radii, 1.0 with vdW).
     pub radius_scale: f32,
     /// Stick radius (Å).
@@ -48,9 +48,9 @@ pub struct SceneOptions {
     pub coloring: Coloring,
 }
 
-impl Default for SceneOptions {
+impl Default for ModelOptions {
     fn default() -> Self {
-        SceneOptions {
+        ModelOptions {
             radius_scale: 0.5,
             stick_radius: 0.15,
             style: Style::BallAndStick,
@@ -61,7 +61,7 @@ impl Default for SceneOptions {
 
 /// A renderable ball-and-stick scene: geometry, BVH, per-slot colours, bounding sphere.
 #[derive(Clone, Debug)]
-pub struct Scene {
+pub struct Model {
     /// Balls and sticks.
     pub geometry: Geometry,
     /// The BVH over them (its `stats` hold build time, node count, SAH cost, bytes).
@@ -78,7 +78,7 @@ pub struct Scene {
     wide: OnceLock<WideBvh>,
 }
 
-impl Scene {
+impl Model {
     /// Builds a scene from atom positions (Å), per-atom base radius (Å, scaled by
     /// `opt.radius_scale`), per-atom colours (packed RGBA8, see [`crate::rgba`]) and bonds.
     /// Bonds with an atom index out of range are ignored. `colors` may be empty (grey).
@@ -91,8 +91,8 @@ impl Scene {
         radius: &[f32],
         colors: &[u32],
         bonds: &[[u32; 2]],
-        opt: &SceneOptions,
-    ) -> Scene {
+        opt: &ModelOptions,
+    ) -> Model {
         let n = x.len();
         let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
         let colors: Vec<u32> = match &opt.coloring {
@@ -134,12 +134,12 @@ impl Scene {
         let mut g = Geometry::from_atoms(x, y, z, &radii, &colors, bonds, opt.stick_radius);
         g.show_balls = opt.style != Style::Licorice;
         g.capped = opt.style == Style::Licorice;
-        Scene::from_geometry(g)
+        Model::from_geometry(g)
     }
 
     /// Builds the BVH and colour tables for ready-made geometry (colours from
     /// `g.balls.color`, grey where missing).
-    pub fn from_geometry(g: Geometry) -> Scene {
+    pub fn from_geometry(g: Geometry) -> Model {
         let bvh = Bvh::build(&g);
         let color = |atom: u32| -> i32 {
             g.balls
@@ -189,7 +189,7 @@ impl Scene {
                 .reduce(|| 0.0, f64::max) as f32;
             (c, r.max(1e-3))
         };
-        Scene {
+        Model {
             geometry: g,
             bvh,
             slot_color_a,
@@ -200,7 +200,7 @@ impl Scene {
         }
     }
 
-    /// The 8-wide BVH of secondary rays ([`crate::SecondaryTraversal::Wide`]), built from
+    /// The 8-wide BVH of secondary rays ((`render::SecondaryTraversal::Wide`)), built from
     /// `bvh` the first time it is asked for (a few ms per million primitives).
     pub fn wide(&self) -> &WideBvh {
         self.wide.get_or_init(|| WideBvh::new(&self.bvh))

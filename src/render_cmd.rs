@@ -6,8 +6,8 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use render::{
-    render_frame_into, render_modal_into, Accum, Camera, Framebuffer, Material, Modality,
-    RenderOptions, SecondaryTraversal, TraceOptions, View,
+    accumulate, render_frame, Accum, Camera, FrameInputs, Framebuffer, Material, Modality,
+    RenderSettings, SecondaryTraversal, TraceOptions, View,
 };
 use spmd::Isa;
 use volume::{
@@ -450,50 +450,45 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         (Some(vs), Some(lv)) => Some(vs.with_light_volume(lv)),
         (vs, _) => vs,
     };
-    let [r, g, b] = background(&args);
-    let opt = RenderOptions {
-        background: render::rgba(r, g, b, 255),
-        ..RenderOptions::default()
+    let settings = render_settings(&args);
+    let inputs = FrameInputs {
+        model: scene.as_ref(),
+        volume: vscene.as_ref(),
+        camera: &camera,
     };
     let t = Instant::now();
-    let fb = match (modality(&args), &scene) {
-        (Some(modality), Some(scene)) => {
-            let topt = trace_options(&args, modality);
-            let path = args.mode == Mode::Path;
-            let spp = samples_per_pixel(&args);
-            let mut acc = Accum::new(w, h)?;
-            let stats =
-                render_modal_into(scene, vscene.as_ref(), &camera, &mut acc, &topt, spp, isa);
-            let secs = stats.time.as_secs_f64();
-            verbose(format!(
-                "render:  {secs:.3} s  {w}x{h} {}{} ({:.2} fps{})",
-                args.mode.name(),
-                modality_name(&args),
-                1.0 / secs.max(1e-12),
-                if path {
-                    format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
-                } else {
-                    String::new()
-                }
-            ));
-            acc.to_framebuffer(path, args.exposure)
-        }
-        _ => {
-            let mut fb = Framebuffer::new(w, h, opt.background)?;
-            let stats =
-                render_frame_into(scene.as_ref(), vscene.as_ref(), &camera, &mut fb, &opt, isa);
-            verbose(format!(
-                "render:  {:.3} s  {}x{} {}{} ({:.1} Mrays/s, {:.2} fps)",
-                t.elapsed().as_secs_f64(),
-                w,
-                h,
-                args.mode.name(),
-                volume_suffix(&args),
-                stats.mrays_per_s(),
-                stats.fps()
-            ));
-            fb
-        }
+    let fb = if settings.modality == Modality::Headlight {
+        let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
+        let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
+        verbose(format!(
+            "render:  {:.3} s  {}x{} {}{} ({:.1} Mrays/s, {:.2} fps)",
+            t.elapsed().as_secs_f64(),
+            w,
+            h,
+            args.mode.name(),
+            volume_suffix(&args),
+            stats.mrays_per_s(),
+            stats.fps()
+        ));
+        fb
+    } else {
+        let path = args.mode == Mode::Path;
+        let spp = samples_per_pixel(&args);
+        let mut acc = Accum::new(w, h)?;
+        let stats = accumulate(&inputs, &settings, &mut acc, spp, isa)?;
+        let secs = stats.time.as_secs_f64();
+        verbose(format!(
+            "render:  {secs:.3} s  {w}x{h} {}{} ({:.2} fps{})",
+            args.mode.name(),
+            modality_name(&args),
+            1.0 / secs.max(1e-12),
+            if path {
+                format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
+            } else {
+                String::new()
+            }
+        ));
+        acc.to_framebuffer(path, args.exposure)
     };
     fb.save_png(&output)
         .with_context(|| format!("writing {}", output.display()))?;
@@ -580,7 +575,7 @@ pub(crate) fn light(args: &RenderArgs) -> Light {
     match (args.light_pos, args.light_dir) {
         (Some(p), _) => Light::Point(p),
         (None, Some(d)) => Light::Directional(d),
-        (None, None) => TraceOptions::default().light,
+        (None, None) => RenderSettings::default().light,
     }
 }
 
@@ -624,7 +619,26 @@ pub(crate) fn trace_options(args: &RenderArgs, modality: Modality) -> TraceOptio
     }
 }
 
-/// Rejects combinations of modality flags that do nothing, with what to use instead.
+/// Every render option of the flags as one [`RenderSettings`] (headlight modes: ambient
+/// [`render::HEADLIGHT_AMBIENT`]; `--ambient` is the ambient term of `--shadows`).
+pub(crate) fn render_settings(args: &RenderArgs) -> RenderSettings {
+    let background = background(args);
+    match modality(args) {
+        None => RenderSettings {
+            march: march_options(args),
+            ..RenderSettings::headlight(background)
+        },
+        Some(modality) => RenderSettings {
+            march: march_options(args),
+            spp: args.spp,
+            background,
+            ..trace_options(args, modality).settings(args.spp)
+        },
+    }
+}
+
+/// Rejects combinations of modality flags that do nothing, with what to use instead: the
+/// flag conflicts here, every rule on the resulting settings in [`RenderSettings::validate`].
 pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
     let m = args.mode;
     if args.lit && matches!(m, Mode::Bs | Mode::Path) {
@@ -640,17 +654,9 @@ pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
              --volume-shadows)"
         );
     }
-    if args.ao == Some(0) {
-        bail!("--ao N needs at least one sample");
-    }
+    // Values of flags the chosen modality does not use are still checked.
     if !(args.ao_distance > 0.0 && args.ao_distance.is_finite()) {
         bail!("--ao-distance must be a positive number of Å");
-    }
-    if !(args.shadow_step > 0.0 && args.shadow_step.is_finite()) {
-        bail!("--shadow-step must be a positive number of voxels");
-    }
-    if args.spp == 0 {
-        bail!("--spp must be at least 1");
     }
     if args.max_depth == 0 {
         bail!("--max-depth must be at least 1");
@@ -658,23 +664,9 @@ pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
     if !(args.roughness >= 0.0 && args.roughness.is_finite()) {
         bail!("--roughness must be a non-negative number");
     }
-    if !(args.exposure > 0.0 && args.exposure.is_finite()) {
-        bail!("--exposure must be a positive number");
-    }
-    if args.volume_shadows {
-        match m {
-            Mode::VolBs if args.shadows => {}
-            Mode::Volume => {}
-            Mode::VolBs => bail!(
-                "--mode vol+bs --volume-shadows needs --shadows (the balls and sticks are then \
-                 shadowed by the geometry and the volume, and the volume by itself)"
-            ),
-            _ => bail!(
-                "--volume-shadows: the volume casts the shadows, so use it with --mode volume \
-                 or --mode vol+bs --shadows"
-            ),
-        }
-    }
+    let has_model = m != Mode::Volume;
+    let has_volume = matches!(m, Mode::Volume | Mode::VolBs);
+    render_settings(args).validate(has_model, has_volume)?;
     Ok(())
 }
 

@@ -17,6 +17,7 @@
 mod build;
 mod geometry;
 mod intersect;
+mod query;
 pub mod scenes;
 mod traverse;
 mod tree;
@@ -30,5 +31,6 @@ pub use intersect::{
 pub use traverse::{
     box_test, load_packet, slab_test, unpack_hits, Hit, PacketHit, Ray, RayPacket, BOX_GROW,
 };
+pub use query::{Query, Stacks, Traversal};
 pub use tree::{BuildStats, Builder, Bvh, Node, INNER, LEAF_MAX};
 pub use wide::{WideBvh, WideEntry, WideNode, WIDTH};

@@ -120,6 +120,33 @@ impl Bvh {
         rays: &[RayPacket<S>; N],
         stack: &mut [u32],
     ) -> [PacketHit<S>; N] {
+        self.query_packets::<S, N, false>(s, rays, stack)
+    }
+
+    /// Lanes of `ray` (active ones) that hit any primitive in `(tmin, tmax)`: the packet
+    /// traversal with any-hit early exit (a lane that hits anything stops taking part in box
+    /// tests; the packet stops when every lane has hit). For shadow and AO rays.
+    #[inline(always)]
+    pub fn occluded_packet<S: Simd>(&self, s: S, ray: &RayPacket<S>, stack: &mut [u32]) -> S::M {
+        let [h] = self.query_packets::<S, 1, true>(
+            s,
+            std::slice::from_ref(ray).try_into().unwrap(),
+            stack,
+        );
+        h.hit_mask(s) & ray.active
+    }
+
+    /// The one packet traversal behind [`Bvh::traverse_packets`] (`ANY = false`: nearest
+    /// hits) and [`Bvh::occluded_packet`] (`ANY = true`: a lane's first hit ends its search,
+    /// its `t` becomes −∞ and its slot says only "occluded"; the packet ends when every
+    /// active lane is occluded) — Embree's closest / any-hit epilogs over one loop.
+    #[inline(always)]
+    fn query_packets<S: Simd, const N: usize, const ANY: bool>(
+        &self,
+        s: S,
+        rays: &[RayPacket<S>; N],
+        stack: &mut [u32],
+    ) -> [PacketHit<S>; N] {
         let nodes = &self.nodes[..];
         let records = &self.records[..];
         let capped = self.capped;
@@ -170,18 +197,48 @@ impl Bvh {
                             if N > 1 && s.none(masks[j]) {
                                 continue;
                             }
-                            intersect_record(
-                                s,
-                                rays[j].o,
-                                rays[j].d,
-                                rec,
-                                capped,
-                                rays[j].tmin,
-                                &mut hits[j].t,
-                                &mut hits[j].slot,
-                                (first + k) as i32,
-                                masks[j],
-                            );
+                            if ANY {
+                                // Any-hit epilog: a hit lane is done (t = −∞ fails every box).
+                                let mut tt = hits[j].t;
+                                let mut slot = s.splat_i(-1);
+                                intersect_record(
+                                    s,
+                                    rays[j].o,
+                                    rays[j].d,
+                                    rec,
+                                    capped,
+                                    rays[j].tmin,
+                                    &mut tt,
+                                    &mut slot,
+                                    (first + k) as i32,
+                                    masks[j],
+                                );
+                                let hit = s.gt_i(slot, s.splat_i(-1));
+                                hits[j].slot = s.select_i(hit, slot, hits[j].slot);
+                                hits[j].t = s.select(hit, s.splat(f32::NEG_INFINITY), hits[j].t);
+                            } else {
+                                intersect_record(
+                                    s,
+                                    rays[j].o,
+                                    rays[j].d,
+                                    rec,
+                                    capped,
+                                    rays[j].tmin,
+                                    &mut hits[j].t,
+                                    &mut hits[j].slot,
+                                    (first + k) as i32,
+                                    masks[j],
+                                );
+                            }
+                        }
+                    }
+                    if ANY {
+                        let mut open = false;
+                        for j in 0..N {
+                            open |= s.any(rays[j].active & !hits[j].hit_mask(s));
+                        }
+                        if !open {
+                            return hits;
                         }
                     }
                 } else {

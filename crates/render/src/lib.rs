@@ -1,21 +1,39 @@
-//! Ball-and-stick rendering (paper §4.2, §4.5 "b&s"): scene assembly (styles, colouring), a
-//! pinhole or orthographic camera with the paper's `far`/`close` views (Table 3), 16×16 tiles
-//! scheduled by rayon, pixel blocks of `LANES` primary rays traced as one packet through the
-//! BVH, headlight diffuse shading, an RGBA8 framebuffer and PNG output.
+//! Rendering (paper §4.2, §4.5): one frame driver — 16×16 tiles scheduled by rayon, camera
+//! rays of a pinhole or orthographic camera, one integrator per modality (headlight b&s,
+//! volume, vol+b&s, direct light with shadows, ambient occlusion, path tracing) — writing a
+//! whole RGBA8 frame, a progressive f32 accumulation, the tiles a caller owns or a band of
+//! rows. All options are one [`RenderSettings`].
 //!
 //! Units: positions and radii in Ångström (Å); field of view in degrees.
 
-mod framebuffer;
-mod tile;
-mod trace;
+#![warn(missing_docs)]
 
+mod accum;
+mod ao_at;
+mod camera_rays;
+mod driver;
+mod framebuffer;
+mod integrator;
+mod legacy;
+mod rng;
+mod settings;
+
+pub use accum::Accum;
+pub use ao_at::ambient_occlusion_at;
+pub use driver::{
+    accumulate, render_frame, render_rows, render_tiles, FrameInputs, RenderStats, TileSet, TILE,
+};
 pub use framebuffer::{Framebuffer, RenderError};
+pub use integrator::{trace, Traced};
+pub use legacy::{
+    render_bs, render_bs_into, render_frame_into, render_modal, render_modal_into, RenderOptions,
+    TraceOptions,
+};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };
-pub use tile::{render_bs, render_bs_into, render_frame_into, RenderOptions, RenderStats, TILE};
-pub use trace::{
-    ambient_occlusion_at, occluded, render_modal, render_modal_into, trace, Accum, Material,
-    Modality, SecondaryTraversal, TraceOptions, Traced,
+pub use settings::{
+    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DIRECT_AMBIENT,
+    HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP,
 };
 pub use volume::Light;

@@ -25,16 +25,13 @@ pub(super) fn sample<S: Simd>(
     };
     let opt = k.set;
     let bg = V3::splat(s, opt.background_unit());
-    let zero = s.splat(0.0);
-    let one = s.splat(1.0);
     let tr = trace(s, Some(model), k.volume, ray, st.packet());
     let mut c = bg;
     if s.any(tr.mask) {
         let o = spawn(s, model, &tr);
         let ao = ao_factor(
             s,
-            k.scene,
-            opt.secondary,
+            q,
             o,
             tr.n,
             tr.mask,

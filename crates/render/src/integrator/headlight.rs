@@ -142,8 +142,7 @@ fn shade_bs<S: Simd>(
     let cb = s.gather_i(&scene.slot_color_b, hit.slot, m, zi);
     let c = s.select_i(srf.second_half, cb, ca);
     // Headlight: the light is at the eye, so the cosine is |n·d|.
-    let ambient = s.splat(ambient);
-    let shade = ambient + s.splat(1.0 - ambient) * s.abs(srf.n.dot(ray.d));
+    let shade = s.splat(ambient) + s.splat(1.0 - ambient) * s.abs(srf.n.dot(ray.d));
     let rgb = channel(s, c, 0, shade)
         | channel(s, c, 8, shade)
         | channel(s, c, 16, shade)

@@ -185,7 +185,6 @@ impl clap::ValueEnum for ModeSel {
     }
     fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
         use clap::builder::PossibleValue;
-        use clap::ValueEnum as _;
         match self {
             ModeSel::One(m) => m.to_possible_value(),
             ModeSel::All => Some(PossibleValue::new("all").help("Every mode above.")),

@@ -4,7 +4,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use spmd::Isa;
 
-mod bench;
+mod bench_cmd;
+mod bench_pipeline;
 mod generate;
 mod info;
 mod input;
@@ -43,7 +44,7 @@ enum Command {
     Generate(generate::GenerateArgs),
     /// Reproduce the paper's Tables 1-3 on this machine: preprocessing figures and fps per
     /// scene, mode, view, frame size, thread count and ISA, beside the paper's.
-    Bench(Box<bench::BenchArgs>),
+    Bench(Box<bench_cmd::BenchArgs>),
 }
 
 /// `--isa`: one backend, or (for `bench`) all the CPU supports.
@@ -95,7 +96,7 @@ fn run(cli: Cli) -> Result<()> {
                 Some(IsaArg::All) => Isa::supported(),
                 _ => vec![isa],
             };
-            bench::run(*args, isas)
+            bench_cmd::run(*args, isas)
         }
         None => {
             use clap::CommandFactory;

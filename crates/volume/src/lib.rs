@@ -14,7 +14,7 @@
 //!    opacity-corrected post-classification table, the pre-integration table and the
 //!    range-max table that decides macrocell emptiness. Changing the transfer function
 //!    rebuilds only this (≈ 0.1 s), never the grid.
-//! 4. [`march`] (one SIMD packet, generic over [`spmd::Simd`]) or [`march_rays`] (a batch,
+//! 4. [`march()`] (one SIMD packet, generic over [`spmd::Simd`]) or [`march_rays`] (a batch,
 //!    dispatched once) with a [`VolumeScene`] and [`MarchOptions`].
 //!
 //! Units: positions in Å; "voxel" as a length is one lattice spacing (1 / voxels-per-Å);

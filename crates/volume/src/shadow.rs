@@ -10,7 +10,7 @@
 //! once `T < 1e-3`.
 //!
 //! The same march serves shadow rays from ball-and-stick hits ([`transmittance`]) and from
-//! the volume's own samples (volumetric shadows, [`crate::march`]). Empty macrocells are
+//! the volume's own samples (volumetric shadows, [`mod@crate::march`]). Empty macrocells are
 //! jumped over; the march is clipped to the volume's box.
 
 use spmd::{Simd, V3};

@@ -1,7 +1,12 @@
 //! Project chores: `cargo xtask matrix [--quick]` runs the test suite once per ISA the CPU
-//! has (with `BNS_ISA` forced), the criterion kernel benches, and portable builds for
+//! has (with `BNS_ISA` forced), the criterion kernel benches, the disassembly check of the
+//! SPMD entry points ([`asm`]), and portable builds for
 //! `-C target-cpu=x86-64 / x86-64-v3 / x86-64-v4`, then prints one table. `cargo xtask bench
-//! [ARGS]` runs `bnsview bench ARGS` built in release mode.
+//! [ARGS]` runs `bnsview bench ARGS` built in release mode. `cargo xtask asm-check` runs only
+//! the disassembly check; `cargo xtask asm <pattern>` prints the disassembly of the functions
+//! whose demangled name contains `pattern` (e.g. `entry::<volume::march::MarchBatch`).
+
+mod asm;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -18,14 +23,28 @@ fn main() -> Result<()> {
     match args.first().map(String::as_str) {
         Some("matrix") => matrix(args[1..].iter().any(|a| a == "--quick")),
         Some("bench") => bench(&args[1..]),
+        Some("asm-check") => {
+            let rows = asm::check(&root())?;
+            asm::print_rows(&rows);
+            if !rows.iter().all(|r| r.ok) {
+                bail!("asm-check: some entry points failed (see above)");
+            }
+            Ok(())
+        }
+        Some("asm") if args.len() == 2 => asm::print_matching(&root(), &args[1]),
         _ => {
             eprintln!("usage: cargo xtask matrix [--quick] | cargo xtask bench [BENCH ARGS]");
+            eprintln!("       cargo xtask asm-check | cargo xtask asm <PATTERN>");
             eprintln!("  matrix   tests per ISA, kernel benches with speedups over scalar,");
             eprintln!("           builds for target-cpu x86-64 / x86-64-v3 / x86-64-v4");
             eprintln!("  --quick  short bench runs (criterion --quick), one wider baseline: the");
             eprintln!("           widest this CPU runs (x86-64-v4 with AVX-512, else v3)");
             eprintln!("  bench    `bnsview bench` in release mode (the paper's Tables 1-3);");
             eprintln!("           e.g. cargo xtask bench --quick --json out.json");
+            eprintln!("  asm-check  disassembly check of the SPMD entry points (table RULES in");
+            eprintln!("           xtask/src/asm.rs; built into target/asm with v0 mangling)");
+            eprintln!("  asm      print the disassembly of functions whose name contains PATTERN,");
+            eprintln!("           e.g. cargo xtask asm 'avx2::entry::<volume::march::MarchBatch'");
             std::process::exit(2)
         }
     }
@@ -237,10 +256,10 @@ fn matrix(quick: bool) -> Result<()> {
     all_ok &= bench_ok;
     let medians = bench_medians()?;
 
-    // 3. Code generation: every backend's entry points in the kernels bench must use that
-    //    backend's registers and call no vector op out of line (a generic op that was not
-    //    inlined into the `#[target_feature]` entry point would be a call).
-    let asm_rows = asm_check()?;
+    // 3. Code generation: every backend's entry points listed in `asm::RULES` must use that
+    //    backend's registers and call no vector op or hot helper out of line (a generic op
+    //    that was not inlined into the `#[target_feature]` entry point would be a call).
+    let asm_rows = asm::check(&root())?;
     all_ok &= asm_rows.iter().all(|r| r.ok);
 
     // 4. Portable builds: the same binary must select the widest backend at run time
@@ -332,20 +351,7 @@ fn matrix(quick: bool) -> Result<()> {
         println!();
     }
     println!();
-    println!(
-        "{:<8} {:>7} {:>9} {:>11}  asm of spmd entry points (kernels bench)",
-        "isa", "entries", "reg insns", "inner calls"
-    );
-    for r in &asm_rows {
-        println!(
-            "{:<8} {:>7} {:>9} {:>11}  {}",
-            r.isa,
-            r.entries,
-            r.wide,
-            r.bad_calls,
-            if r.ok { "ok" } else { "FAILED" }
-        );
-    }
+    asm::print_rows(&asm_rows);
     println!();
     println!("{:<10} {:<6} bnsview --version", "target-cpu", "ok");
     for (cpu, sel, good) in &cpu_rows {
@@ -360,84 +366,6 @@ fn matrix(quick: bool) -> Result<()> {
         bail!("matrix: something failed (see above)");
     }
     Ok(())
-}
-
-struct AsmRow {
-    isa: &'static str,
-    entries: usize,
-    wide: usize,
-    bad_calls: usize,
-    ok: bool,
-}
-
-/// Disassembles the `spmd::x86::<isa>::entry` instances of the kernels bench binary with
-/// `objdump` and counts instructions on the backend's registers and calls into spmd or
-/// `core::arch` code (which would mean a vector op was not inlined).
-fn asm_check() -> Result<Vec<AsmRow>> {
-    let mut c = cargo();
-    c.args([
-        "bench",
-        "--bench",
-        "kernels",
-        "--no-run",
-        "--message-format=short",
-    ]);
-    let (ok, text) = run_logged(c, "cargo bench --bench kernels --no-run")?;
-    if !ok {
-        bail!("building the kernels bench failed");
-    }
-    let exe = text
-        .lines()
-        .find_map(|l| {
-            l.trim()
-                .strip_prefix("Executable ")
-                .and_then(|r| r.split('(').nth(1))
-                .map(|p| p.trim_end_matches(')'))
-        })
-        .context("finding the kernels bench executable in cargo's output")?;
-    let exe = root().join(exe);
-    let dump = Command::new("objdump")
-        .args(["-d", "--no-show-raw-insn", "-C"])
-        .arg(&exe)
-        .output()
-        .context("running objdump (Debian package binutils)")?;
-    let dump = String::from_utf8_lossy(&dump.stdout);
-    let mut rows = Vec::new();
-    for (isa, module, reg) in [
-        ("sse4.1", "sse41", "%xmm"),
-        ("avx2", "avx2", "%ymm"),
-        ("avx512", "avx512", "%zmm"),
-    ] {
-        let header = format!("<spmd::x86::{module}::entry");
-        let (mut entries, mut wide, mut bad) = (0, 0, 0);
-        let mut inside = false;
-        for line in dump.lines() {
-            if line.ends_with(">:") {
-                inside = line.contains(&header);
-                entries += inside as usize;
-                continue;
-            }
-            if !inside {
-                continue;
-            }
-            wide += line.contains(reg) as usize;
-            if line.contains("call")
-                && (line.contains("core_arch")
-                    || line.contains("<spmd::x86")
-                    || line.contains("as spmd::Simd"))
-            {
-                bad += 1;
-            }
-        }
-        rows.push(AsmRow {
-            isa,
-            entries,
-            wide,
-            bad_calls: bad,
-            ok: entries > 0 && wide > 0 && bad == 0,
-        });
-    }
-    Ok(rows)
 }
 
 fn fmt_ns(ns: f64) -> String {

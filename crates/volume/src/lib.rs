@@ -14,7 +14,7 @@
 //!    opacity-corrected post-classification table, the pre-integration table and the
 //!    range-max table that decides macrocell emptiness. Changing the transfer function
 //!    rebuilds only this (≈ 0.1 s), never the grid.
-//! 4. [`march`] (one SIMD packet, generic over [`spmd::Simd`]) or [`march_rays`] (a batch,
+//! 4. [`march()`] (one SIMD packet, generic over [`spmd::Simd`]) or [`march_rays`] (a batch,
 //!    dispatched once) with a [`VolumeScene`] and [`MarchOptions`].
 //!
 //! Units: positions in Å; "voxel" as a length is one lattice spacing (1 / voxels-per-Å);
@@ -53,24 +53,27 @@
 //! Inside a renderer's own SIMD kernel, call [`march()`] on a packet instead
 //! (`march::<S>(s, &scene, orig, dir, tmax, active)` → `[r, g, b, a]` varying).
 
+#![warn(missing_docs)]
+
 pub mod grid;
 pub mod light;
 pub mod macrocell;
 pub mod march;
+mod sampler;
+pub mod scene;
 pub mod shadow;
+mod tau;
 pub mod tf;
 
 pub use grid::{
     build_density, default_budget_bytes, estimate_bytes, DensityParams, Grid, Volume, VolumeData,
     VolumeFormat,
 };
-pub use light::LightVolume;
 pub use macrocell::{Macrocells, MACROCELL};
-pub use march::{
-    classify_values, march, march_rays, sample_points, Lighting, MarchOptions, Rays, VolumeScene,
-    VolumeShadows,
-};
-pub use shadow::{transmittance, Light};
+pub use march::{classify_values, march, march_rays, Rays};
+pub use sampler::sample_points;
+pub use scene::{Light, LightVolume, Lighting, MarchOptions, VolumeScene, VolumeShadows};
+pub use shadow::transmittance;
 pub use tf::{
     preintegrate, ClassifiedTf, ControlPoint, Preset, TfError, TransferFunction, TF_SIZE,
 };

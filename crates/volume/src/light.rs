@@ -17,23 +17,12 @@
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd, V3};
 
-use crate::grid::{Grid, VolumeData};
+use crate::grid::Grid;
 use crate::macrocell::MACROCELL;
-use crate::march::{trilinear, F32Voxels, Lattice, U8Voxels, VolumeScene, VolumeShadows};
-use crate::shadow::{march_tau, Light};
-
-/// Transmittance towards one light on every `stride`-th lattice point, 8 bits per point.
-#[derive(Clone, Debug)]
-pub struct LightVolume {
-    /// The lattice of the stored points (origin of the density grid, spacing × stride).
-    pub grid: Grid,
-    /// Density lattice cells per light lattice cell (1, 2, 4 or 8: divides the macrocell).
-    pub stride: usize,
-    /// `round(255·T)` per point, x fastest.
-    pub data: Vec<u8>,
-    /// The light and step it was built for.
-    pub shadows: VolumeShadows,
-}
+use crate::sampler::{with_lattice, Lattice, OnLattice, Voxels};
+pub use crate::scene::LightVolume;
+use crate::scene::{VolumeScene, VolumeShadows};
+use crate::tau::march_tau;
 
 impl LightVolume {
     /// Marches a shadow ray from every `stride`-th lattice point of `scene`'s volume towards
@@ -73,18 +62,6 @@ impl LightVolume {
             shadows,
         }
     }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> u64 {
-        self.data.len() as u64
-    }
-
-    /// Transmittance at density-grid coordinates `p` (voxels), trilinear.
-    #[inline(always)]
-    pub(crate) fn sample<S: Simd>(&self, s: S, p: V3<S>, m: S::M) -> S::F32 {
-        let lat = Lattice::new(&self.grid, U8Voxels(&self.data), 1.0 / 255.0);
-        trilinear(s, &lat, p.scale(s.splat(1.0 / self.stride as f32)), m)
-    }
 }
 
 /// Per macrocell: does the transfer function make anything in it visible? (As the marcher's
@@ -115,17 +92,27 @@ impl Kernel for PlaneKernel<'_, '_> {
     type Output = ();
     #[inline(always)]
     fn run<S: Simd>(self, s: S) {
-        let v = self.scene.volume;
-        match &v.data {
-            VolumeData::F32(d) => plane(s, self, &Lattice::new(&v.grid, F32Voxels(d), 1.0)),
-            VolumeData::U8 { data, scale } => {
-                plane(s, self, &Lattice::new(&v.grid, U8Voxels(data), *scale))
-            }
-        }
+        let vol = self.scene.volume;
+        with_lattice(vol, PlaneOn { s, k: self })
+    }
+}
+
+/// [`plane`] on one storage format.
+struct PlaneOn<'a, 'b, S: Simd> {
+    s: S,
+    k: PlaneKernel<'a, 'b>,
+}
+
+impl<S: Simd> OnLattice for PlaneOn<'_, '_, S> {
+    type Output = ();
+    #[inline(always)]
+    fn run<V: Voxels>(self, lat: &Lattice<V>) {
+        plane(self.s, self.k, lat)
     }
 }
 
 /// Macrocell indices (at most two) whose closed extent holds lattice coordinate `x`.
+#[inline(always)]
 fn cells_at(x: usize, ncells: usize) -> [usize; 2] {
     let c = (x / MACROCELL).min(ncells - 1);
     let prev = if x.is_multiple_of(MACROCELL) && x > 0 {
@@ -136,18 +123,36 @@ fn cells_at(x: usize, ncells: usize) -> [usize; 2] {
     [prev, c]
 }
 
-// One z-plane of the light volume: shadow rays from the points of non-empty cells.
+/// Is any of the (at most 2×2×2) macrocells `cx × cy × cz` occupied (grid of `cd` cells)?
 #[inline(always)]
-fn plane<S: Simd, V: crate::march::Voxels>(s: S, k: PlaneKernel, lat: &Lattice<V>) {
+fn any_occupied(
+    occupied: &[bool],
+    cd: [usize; 3],
+    cx: [usize; 2],
+    cy: [usize; 2],
+    cz: [usize; 2],
+) -> bool {
+    for c2 in cz {
+        for c1 in cy {
+            for c0 in cx {
+                if occupied[c0 + cd[0] * (c1 + cd[1] * c2)] {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
+// Paper §4.5: one z-plane of the light volume, shadow rays from the points of non-empty cells.
+#[inline(always)]
+fn plane<S: Simd, V: Voxels>(s: S, k: PlaneKernel, lat: &Lattice<V>) {
     let sc = k.scene;
     let g = &sc.volume.grid;
     let cd = sc.cells.dims;
     let st = k.stride;
     let [nx, ny, _] = k.dims;
-    let light = match k.shadows.light {
-        Light::Directional(d) => Light::Directional(d),
-        Light::Point(q) => Light::Point(core::array::from_fn(|a| (q[a] - g.origin[a]) / g.spacing)),
-    };
+    let light = k.shadows.light.in_grid(g);
     let z = (k.k * st) as f32;
     let cz = cells_at(k.k * st, cd[2]);
     let mut need = [0i32; spmd::MAX_LANES];
@@ -160,15 +165,8 @@ fn plane<S: Simd, V: crate::march::Voxels>(s: S, k: PlaneKernel, lat: &Lattice<V
             let n = (nx - i0).min(S::LANES);
             let mut any = false;
             for l in 0..S::LANES {
-                let hit = l < n && {
-                    let cx = cells_at((i0 + l) * st, cd[0]);
-                    cz.iter().any(|&c2| {
-                        cy.iter().any(|&c1| {
-                            cx.iter()
-                                .any(|&c0| k.occupied[c0 + cd[0] * (c1 + cd[1] * c2)])
-                        })
-                    })
-                };
+                let hit =
+                    l < n && any_occupied(k.occupied, cd, cells_at((i0 + l) * st, cd[0]), cy, cz);
                 need[l] = hit as i32;
                 any |= hit;
                 xs[l] = ((i0 + l) * st) as f32;

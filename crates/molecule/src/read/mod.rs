@@ -327,9 +327,7 @@ fn sniff(path: &Path) -> Result<Option<Format>, ReadError> {
 
 /// Format guessed from the first lines of a file (trimmed), if any.
 fn sniff_lines(head: &[Vec<u8>]) -> Option<Format> {
-    let Some(t) = head.iter().find(|l| !l.is_empty()) else {
-        return None;
-    };
+    let t = head.iter().find(|l| !l.is_empty())?;
     let is_count = |l: &[u8]| lex::parse_usize(l).is_some();
     // .gro: title, atom count, then fixed-column atom lines (>= 44 columns).
     if head.len() >= 3 && !is_count(&head[0]) && is_count(&head[1]) && head[2].len() >= 36 {
@@ -344,7 +342,7 @@ fn sniff_lines(head: &[Vec<u8>]) -> Option<Format> {
     }
     if t.starts_with(b"ITEM:") {
         Some(Format::LammpsDump)
-    } else if lex::parse_usize(&t).is_some() {
+    } else if lex::parse_usize(t).is_some() {
         Some(Format::Xyz)
     } else if [
         &b"ATOM"[..],

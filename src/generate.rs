@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context};
 use clap::Args;
-use molecule::scenes::{generate, SceneName};
+use molecule::scenes::{try_generate, SceneName};
 use molecule::write::{write_lammps_dump, write_xyz};
 use std::fs::OpenOptions;
 use std::io::{BufWriter, Write};
@@ -43,6 +43,10 @@ pub fn run(args: GenerateArgs) -> anyhow::Result<()> {
             args.output.display()
         );
     };
+    // Refuse absurd --atoms before creating the output file or allocating anything.
+    if let Some(n) = args.atoms {
+        molecule::scenes::check_atoms(n, molecule::scenes::available_memory())?;
+    }
     let mut opts = OpenOptions::new();
     opts.write(true);
     if args.force {
@@ -62,7 +66,7 @@ pub fn run(args: GenerateArgs) -> anyhow::Result<()> {
     })?;
     let pb = crate::input::spinner(&format!("generating {}", args.scene));
     let t = Instant::now();
-    let m = generate(args.scene, args.atoms, args.seed);
+    let m = try_generate(args.scene, args.atoms, args.seed)?;
     let gen_s = t.elapsed().as_secs_f64();
     pb.set_message(format!("writing {} atoms", m.len()));
     let t = Instant::now();

@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use molecule::bonds::{build_bonds, BondOptions};
-use molecule::read::{open, Format, ReadOptions};
-use molecule::scenes::{generate, SceneName};
+use molecule::bonds::{try_build_bonds, BondOptions};
+use molecule::read::{open, Format, FrameIndex, ReadOptions};
+use molecule::scenes::{try_generate, SceneName};
 use molecule::Molecule;
 
 /// Where bonds come from.
@@ -47,9 +47,9 @@ pub struct InputArgs {
     /// LAMMPS data atom style if the file does not say (atomic, charge, molecular, full).
     #[arg(long)]
     pub atom_style: Option<String>,
-    /// Frame to describe (0-based).
-    #[arg(long, default_value_t = 0)]
-    pub frame: usize,
+    /// Frame to describe (0-based; negative counts from the end, -1 = last).
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    pub frame: i64,
     /// Bond source.
     #[arg(long, value_enum, default_value_t = BondSource::Auto)]
     pub bonds: BondSource,
@@ -130,7 +130,7 @@ impl InputArgs {
                 );
             }
             pb.set_message(format!("generating {scene}"));
-            let m = generate(scene, self.atoms, self.seed);
+            let m = try_generate(scene, self.atoms, self.seed)?;
             (
                 format!("scene {scene} (seed {})", self.seed),
                 m,
@@ -155,7 +155,7 @@ impl InputArgs {
             let bytes = std::fs::metadata(&path).map(|m| m.len()).ok();
             pb.set_message(format!("reading {}", path.display()));
             let mut t = open(&path, &opts)?;
-            let m = t.read_frame(self.frame)?;
+            let m = t.read_frame_at(FrameIndex::from(self.frame))?;
             let frames = if count_frames {
                 pb.set_message("counting frames".to_string());
                 t.count_frames()?
@@ -179,7 +179,7 @@ impl InputArgs {
         pb.set_message(format!("building bonds for {} atoms", m.len()));
         let t1 = Instant::now();
         let bonds = match self.bonds {
-            BondSource::Auto => build_bonds(&m, &bond_opts),
+            BondSource::Auto => try_build_bonds(&m, &bond_opts)?,
             BondSource::File => match &m.file_bonds {
                 Some(b) => b.clone(),
                 None => {

@@ -205,6 +205,16 @@ pub fn brute_force_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
         .collect()
 }
 
+/// Cells along one axis for `ratio` = extent / cell size: `floor(ratio) + 1`, in
+/// `1..=2^20` (NaN and infinity give the cap or 1, never an overflow).
+fn axis_cells(ratio: f64) -> usize {
+    const CAP: f64 = (1u32 << 20) as f64;
+    if ratio.is_nan() {
+        return 1;
+    }
+    (ratio.floor() + 1.0).clamp(1.0, CAP) as usize
+}
+
 /// Uniform grid: `dims` cells, atoms listed cell by cell.
 struct Grid {
     dims: [usize; 3],
@@ -231,9 +241,7 @@ impl Grid {
         let max_cells = (2 * n + 1024) as f64;
         let (dims, wrap, keys): ([usize; 3], [bool; 3], Vec<u32>) = match &rule.pbc {
             Some(p) => {
-                let mut dims = p
-                    .widths
-                    .map(|w| ((w / cut).floor() as usize).clamp(1, 1 << 20));
+                let mut dims = p.widths.map(|w| axis_cells(w / cut - 1.0));
                 while (dims[0] * dims[1] * dims[2]) as f64 > max_cells {
                     for d in dims.iter_mut() {
                         *d = (*d * 4 / 5).max(1);
@@ -261,9 +269,18 @@ impl Grid {
             }
             None => {
                 let (lo, hi) = m.bounds();
-                let ext = [0, 1, 2].map(|k| f64::from(hi[k] - lo[k]).max(0.0));
+                let ext = [0, 1, 2].map(|k| {
+                    let e = f64::from(hi[k]) - f64::from(lo[k]);
+                    if e.is_finite() {
+                        e.max(0.0)
+                    } else {
+                        0.0
+                    }
+                });
                 let mut s = cut;
-                let dims_for = |s: f64| ext.map(|e| ((e / s).floor() as usize + 1).min(1 << 20));
+                // Cell counts are computed in f64 and capped before the cast, so a huge or
+                // infinite extent gives a coarse grid instead of an overflowing one.
+                let dims_for = |s: f64| ext.map(|e| axis_cells(e / s));
                 let mut dims = dims_for(s);
                 while (dims[0] * dims[1] * dims[2]) as f64 > max_cells {
                     s *= 1.25;
@@ -310,6 +327,38 @@ impl Grid {
         }
     }
 
+    /// Upper bound on the pairs the neighbour search tests: the sum over cells and their
+    /// distinct neighbouring cells of `n_i · n_j / 2` (O(cells), no allocation).
+    fn candidate_pairs(&self) -> u64 {
+        let [dx, dy, dz] = self.dims;
+        let count = |c: usize| u64::from(self.start[c + 1] - self.start[c]);
+        let (mut nx, mut ny, mut nz) = ([0usize; 3], [0usize; 3], [0usize; 3]);
+        let mut total = 0u64;
+        for z in 0..dz {
+            let cz = self.axis_neighbours(z, 2, &mut nz);
+            for y in 0..dy {
+                let cy = self.axis_neighbours(y, 1, &mut ny);
+                for x in 0..dx {
+                    let here = count(x + dx * (y + dy * z));
+                    if here == 0 {
+                        continue;
+                    }
+                    let cx = self.axis_neighbours(x, 0, &mut nx);
+                    let mut around = 0u64;
+                    for &c in &nz[..cz] {
+                        for &b in &ny[..cy] {
+                            for &a in &nx[..cx] {
+                                around += count(a + dx * (b + dy * c));
+                            }
+                        }
+                    }
+                    total = total.saturating_add(here.saturating_mul(around) / 2);
+                }
+            }
+        }
+        total
+    }
+
     /// Distinct neighbour indices along one axis.
     fn axis_neighbours(&self, c: usize, k: usize, out: &mut [usize; 3]) -> usize {
         let d = self.dims[k];
@@ -334,6 +383,9 @@ impl Grid {
 
 /// Bonds of `m` under `opts`: pairs `[i, j]` with `i < j`, sorted, deterministic regardless
 /// of thread count. Uses a uniform grid and rayon.
+///
+/// Unchecked: never panics, but an absurd cutoff or a far-away atom can make it quadratic
+/// and huge. Use [`try_build_bonds`] for untrusted input.
 pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
     let n = m.len();
     if n < 2 {
@@ -344,6 +396,139 @@ pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
         return Vec::new();
     }
     let grid = Grid::build(&rule);
+    collect_bonds(&rule, &grid)
+}
+
+/// [`build_bonds`] with limits, for untrusted input: refuses (before any large allocation)
+/// when the grid extent is more than [`MAX_EXTENT_CELLS`] cutoffs or not finite
+/// ([`BondError::Extent`], naming the farthest atom), and when the estimated number of
+/// candidate pairs exceeds [`max_candidate_pairs`] ([`BondError::TooMany`]); the output is
+/// reserved with `try_reserve` ([`BondError::Alloc`]). Same bonds as [`build_bonds`] otherwise.
+pub fn try_build_bonds(m: &Molecule, opts: &BondOptions) -> Result<Vec<[u32; 2]>, BondError> {
+    let n = m.len();
+    if n < 2 {
+        return Ok(Vec::new());
+    }
+    let rule = Rule::new(m, opts);
+    if rule.max_cut <= 0.0 {
+        return Ok(Vec::new());
+    }
+    if rule.pbc.is_none() {
+        check_extent(m, rule.max_cut)?;
+    }
+    let grid = Grid::build(&rule);
+    let estimate = grid.candidate_pairs();
+    let cap = max_candidate_pairs(n);
+    if estimate > cap {
+        return Err(BondError::TooMany {
+            estimate,
+            atoms: n,
+            cap,
+            cutoff: rule.max_cut,
+        });
+    }
+    let mut probe: Vec<[u32; 2]> = Vec::new();
+    probe
+        .try_reserve(estimate.min(16 * n as u64) as usize)
+        .map_err(|_| BondError::Alloc {
+            bytes: estimate.min(16 * n as u64) * 8,
+        })?;
+    drop(probe);
+    Ok(collect_bonds(&rule, &grid))
+}
+
+/// Largest grid extent, in units of the largest cutoff, that [`try_build_bonds`] accepts
+/// (2^24: beyond it `f32` positions cannot resolve bond lengths anyway).
+pub const MAX_EXTENT_CELLS: f64 = (1u32 << 24) as f64;
+
+/// Cap on the estimated candidate pairs for `atoms` atoms in [`try_build_bonds`]:
+/// `64 · atoms + 2^20` (a dense solid at the default factor needs about 25 per atom).
+pub fn max_candidate_pairs(atoms: usize) -> u64 {
+    64 * atoms as u64 + (1 << 20)
+}
+
+/// Why [`try_build_bonds`] refused.
+#[derive(Debug, thiserror::Error)]
+pub enum BondError {
+    /// The atoms span too large (or a non-finite) extent for the bond grid.
+    #[error(
+        "atom {atom} (1-based) at {axis} = {coord:e} Å makes the bond search span {extent:e} Å \
+         along {axis}, more than 2^24 bond cutoffs ({cutoff} Å); fix the coordinates or pass \
+         --bonds none"
+    )]
+    Extent {
+        /// 1-based index of the atom farthest out along `axis`.
+        atom: usize,
+        /// Axis name (`x`, `y`, `z`).
+        axis: char,
+        /// Its coordinate (Å).
+        coord: f32,
+        /// Extent of all atoms along `axis` (Å; may be infinite).
+        extent: f64,
+        /// Largest bond cutoff (Å).
+        cutoff: f32,
+    },
+    /// Too many atom pairs would be tested / could bond.
+    #[error(
+        "the bond cutoff ({cutoff} Å) would test about {estimate} atom pairs for {atoms} atoms \
+         (up to {} MB of bonds; limit {cap} pairs); lower --bond-cutoff / --bond-factor or \
+         pass --bonds none",
+        estimate.saturating_mul(8) / 1_000_000
+    )]
+    TooMany {
+        /// Estimated candidate pairs (sum over neighbouring grid cells of n_i·n_j / 2).
+        estimate: u64,
+        /// Atoms in the molecule.
+        atoms: usize,
+        /// The limit ([`max_candidate_pairs`]).
+        cap: u64,
+        /// Largest bond cutoff (Å).
+        cutoff: f32,
+    },
+    /// The bond list could not be allocated.
+    #[error("cannot allocate {bytes} bytes for bonds; pass --bonds none or a smaller cutoff")]
+    Alloc {
+        /// Bytes requested.
+        bytes: u64,
+    },
+}
+
+/// [`BondError::Extent`] when the non-periodic grid would span more than
+/// [`MAX_EXTENT_CELLS`] cutoffs (or an infinite extent) along some axis.
+fn check_extent(m: &Molecule, cut: f32) -> Result<(), BondError> {
+    let (lo, hi) = m.bounds();
+    for (k, v) in [&m.x, &m.y, &m.z].into_iter().enumerate() {
+        let extent = f64::from(hi[k]) - f64::from(lo[k]);
+        if extent.is_finite() && extent <= MAX_EXTENT_CELLS * f64::from(cut) {
+            continue;
+        }
+        // The atom farthest from the median is the outlier.
+        let mut sorted: Vec<f32> = v.clone();
+        sorted.sort_unstable_by(f32::total_cmp);
+        let mid = f64::from(sorted[sorted.len() / 2]);
+        let (atom, &coord) = v
+            .iter()
+            .enumerate()
+            .max_by(|a, b| {
+                let da = (f64::from(*a.1) - mid).abs();
+                let db = (f64::from(*b.1) - mid).abs();
+                da.total_cmp(&db)
+            })
+            .unwrap_or((0, &0.0));
+        return Err(BondError::Extent {
+            atom: atom + 1,
+            axis: ['x', 'y', 'z'][k],
+            coord,
+            extent,
+            cutoff: cut,
+        });
+    }
+    Ok(())
+}
+
+/// Bonds from a built grid (the parallel neighbour search of [`build_bonds`]).
+fn collect_bonds(rule: &Rule<'_>, grid: &Grid) -> Vec<[u32; 2]> {
+    let n = rule.m.len();
     const CHUNK: usize = 4096;
     let chunks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(CHUNK))
         .into_par_iter()

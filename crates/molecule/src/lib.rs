@@ -15,7 +15,7 @@ pub mod read;
 pub mod scenes;
 pub mod write;
 
-pub use read::{open, Format, ReadError, ReadOptions, Trajectory};
+pub use read::{open, Format, FrameIndex, ReadError, ReadOptions, Trajectory};
 
 /// A periodic cell / simulation box: `origin` plus three edge vectors `a`, `b`, `c` (Å).
 /// Orthogonal boxes have `a = (lx,0,0)`, `b = (0,ly,0)`, `c = (0,0,lz)`; LAMMPS triclinic boxes

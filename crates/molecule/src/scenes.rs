@@ -115,6 +115,82 @@ pub fn generate(name: SceneName, atoms: Option<usize>, seed: u64) -> Molecule {
     }
 }
 
+/// Largest atom count [`try_generate`] accepts (2^31: atom indices are `u32`, and bonds of
+/// twice as many atoms would overflow them).
+pub const MAX_ATOMS: usize = 1 << 31;
+
+/// Bytes per atom assumed by [`try_generate`]'s memory check: positions and element (13 B)
+/// plus generator scratch (a lower bound; rendering needs several times more).
+pub const BYTES_PER_ATOM: u64 = 64;
+
+/// Why [`try_generate`] refused.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// More atoms than [`MAX_ATOMS`].
+    #[error("{atoms} atoms is more than the limit of {max} (2^31); ask for fewer with --atoms")]
+    TooManyAtoms {
+        /// Requested atoms.
+        atoms: usize,
+        /// [`MAX_ATOMS`].
+        max: usize,
+    },
+    /// The model would not fit in the available memory.
+    #[error(
+        "{atoms} atoms need at least {bytes} bytes ({:.1} GB) but only {available} bytes \
+         ({:.1} GB) are available; ask for fewer with --atoms",
+        *bytes as f64 / 1e9,
+        *available as f64 / 1e9
+    )]
+    OutOfMemory {
+        /// Requested atoms.
+        atoms: usize,
+        /// Estimated bytes ([`BYTES_PER_ATOM`] per atom).
+        bytes: u64,
+        /// Available memory (bytes, `MemAvailable` of `/proc/meminfo`).
+        available: u64,
+    },
+}
+
+/// Available memory in bytes (`MemAvailable` from `/proc/meminfo`), if known.
+pub fn available_memory() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kb.checked_mul(1024)
+}
+
+/// Check a requested atom count against [`MAX_ATOMS`] and `available` memory (bytes; `None`
+/// = unknown, not checked) before anything is allocated.
+pub fn check_atoms(atoms: usize, available: Option<u64>) -> Result<(), SceneError> {
+    if atoms > MAX_ATOMS {
+        return Err(SceneError::TooManyAtoms {
+            atoms,
+            max: MAX_ATOMS,
+        });
+    }
+    let bytes = (atoms as u64).saturating_mul(BYTES_PER_ATOM);
+    match available {
+        Some(available) if bytes > available => Err(SceneError::OutOfMemory {
+            atoms,
+            bytes,
+            available,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// [`generate`] after [`check_atoms`] with [`available_memory`]: refuses absurd atom counts
+/// instead of aborting on allocation.
+pub fn try_generate(
+    name: SceneName,
+    atoms: Option<usize>,
+    seed: u64,
+) -> Result<Molecule, SceneError> {
+    let n = atoms.unwrap_or(name.default_atoms()).max(1);
+    check_atoms(n, available_memory())?;
+    Ok(generate(name, Some(n), seed))
+}
+
 // ---------------------------------------------------------------- helpers
 
 fn splitmix(mut x: u64) -> u64 {

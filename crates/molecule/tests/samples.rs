@@ -11,6 +11,15 @@ use std::path::PathBuf;
 fn data_dir() -> PathBuf {
     let ws = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let d = ws.join("../shared/data");
+    // Worktrees live one level deeper than the main checkout: look further up.
+    let d = if d.is_dir() {
+        d
+    } else {
+        ws.ancestors()
+            .map(|a| a.join("shared/data"))
+            .find(|d| d.is_dir())
+            .unwrap_or(d)
+    };
     assert!(
         d.is_dir(),
         "sample data directory not found at {} (expected <workspace>/../shared/data)",

@@ -252,6 +252,15 @@ impl FrameParser for DumpParser {
                 for (k, pk) in p.iter_mut().enumerate() {
                     *pk = origin[k] + h_mat[k][0] * s[0] + h_mat[k][1] * s[1] + h_mat[k][2] * s[2];
                 }
+                // Scaled → Cartesian first, then check the f32 result is finite.
+                if p.iter().any(|&v| !(v as f32).is_finite()) {
+                    let l = line.to_vec();
+                    return Err(r.error(
+                        ln,
+                        "scaled coordinates giving a finite position in Å",
+                        &l,
+                    ));
+                }
             }
             if let Some(c) = id_col {
                 match parse_i64(f(c)) {

@@ -75,8 +75,9 @@ impl FrameParser for GroParser {
             let mut p = [0f32; 3];
             for (k, pk) in p.iter_mut().enumerate() {
                 let t = trim(&line[20 + k * width..20 + (k + 1) * width]);
-                match parse_f64(t) {
-                    Some(v) if v.is_finite() => *pk = (v * 10.0) as f32,
+                // Scale nm → Å first, then check: 1e39 nm is finite in f64 but inf in f32 Å.
+                match parse_f64(t).map(|v| (v * 10.0) as f32) {
+                    Some(v) if v.is_finite() => *pk = v,
                     Some(_) => {
                         let t = t.to_vec();
                         return Err(r.error(
@@ -112,12 +113,16 @@ impl FrameParser for GroParser {
             m.push(p, z);
         }
         let (ln, l) = r.expect_line("the box line")?;
-        let nums: Vec<f32> = super::lex::fields(l).map_while(parse_f32).collect();
+        // Scaled to Å before the finiteness check.
+        let nums: Vec<f32> = super::lex::fields(l)
+            .map_while(parse_f32)
+            .map(|v| v * 10.0)
+            .collect();
         if (nums.len() != 3 && nums.len() != 9) || nums.iter().any(|x| !x.is_finite()) {
             let l = l.to_vec();
-            return Err(r.error(ln, "the box line (3 or 9 numbers in nm)", &l));
+            return Err(r.error(ln, "the box line (3 or 9 numbers in nm, finite in Å)", &l));
         }
-        let g = |i: usize| nums.get(i).copied().unwrap_or(0.0) * 10.0;
+        let g = |i: usize| nums.get(i).copied().unwrap_or(0.0);
         if nums.iter().any(|&x| x != 0.0) {
             m.cell = Some(Cell {
                 origin: [0.0; 3],

@@ -5,7 +5,13 @@
 //! `write_dump ... xu` and ASE do).
 //!
 //! Elements per type: [`super::ReadOptions::types`] first, else the nearest standard atomic
-//! weight to the `Masses` entry (within 0.5 u), else unknown (Z = 0, with a warning).
+//! weight to the `Masses` entry (within 0.5 u) read as g/mol, else the same with the entry
+//! read as kg/mol (×1000: `0.012` is C, for files written in SI units), else unknown (Z = 0,
+//! with a warning).
+//!
+//! Consistency: the `Atoms` and (when the header declares bonds) `Bonds` sections must have
+//! exactly the declared number of lines — a file cut short is an error naming the section the
+//! file ended in — and every box `lo hi` pair must have `lo <= hi`.
 //! Scalars: `id`, `type`, and `mol` / `q` when the style has them.
 
 use super::lex::{fields, parse_f32, parse_f64, parse_i64, parse_usize, split_spans, trim, ErrCtx};
@@ -94,6 +100,9 @@ impl FrameParser for DataParser {
         let mut tilt = [0f64; 3];
         let mut masses: HashMap<i64, f64> = HashMap::new();
         let mut section = Section::Header;
+        // Name and line of the section being read, for truncation errors.
+        let mut section_name = String::from("header");
+        let mut section_line = 1u64;
         let mut style: Option<Style> = None;
         // Atoms: (id, type, x, y, z, mol, q)
         // Atoms, structure-of-arrays in file order (sorted by id at the end).
@@ -115,6 +124,8 @@ impl FrameParser for DataParser {
             let first = body[0];
             if first.is_ascii_alphabetic() {
                 // Section header.
+                section_name = String::from_utf8_lossy(body).into_owned();
+                section_line = ln;
                 section = match body {
                     b"Masses" => Section::Masses,
                     b"Atoms" => {
@@ -150,6 +161,9 @@ impl FrameParser for DataParser {
                         .position(|w| words.len() == 4 && words[2] == *w)
                     {
                         match (num(0), num(1)) {
+                            (Some(a), Some(b)) if a.is_finite() && b.is_finite() && a > b => {
+                                return Err(bad(&ec, "a box with lo <= hi"))
+                            }
                             (Some(a), Some(b)) if a.is_finite() && b.is_finite() => {
                                 lo_hi[k] = [a, b];
                                 have_box[k] = true;
@@ -271,9 +285,18 @@ impl FrameParser for DataParser {
                                 + image[2] as f64 * e[2][k];
                         }
                     }
+                    // Unwrapped by the image flags and rounded to f32 first, then checked.
+                    let pf = p.map(|v| v as f32);
+                    if pf.iter().any(|v| !v.is_finite()) {
+                        return Err(ec.error(
+                            ln,
+                            "a position that stays finite in f32 after unwrapping (image flags)",
+                            body,
+                        ));
+                    }
                     ids.push(id);
                     types.push(ty);
-                    pos.push([p[0] as f32, p[1] as f32, p[2] as f32], 0);
+                    pos.push(pf, 0);
                     if mc.is_some() {
                         mols.push(mol);
                     }
@@ -300,20 +323,21 @@ impl FrameParser for DataParser {
             let next = r.line_no() + 1;
             return Err(r.error(next, "an 'N atoms' header line", b"end of file"));
         };
+        let ended = format!("the file ends in section {section_name} (line {section_line})");
         if ids.len() != n {
             let next = r.line_no() + 1;
             return Err(r.error(
                 next,
                 &format!("{n} lines in the Atoms section (header says {n} atoms)"),
-                format!("{} atom lines", ids.len()).as_bytes(),
+                format!("{} atom lines; {ended}", ids.len()).as_bytes(),
             ));
         }
-        if !bonds_raw.is_empty() && bonds_raw.len() != n_bonds {
+        if bonds_raw.len() != n_bonds {
             let next = r.line_no() + 1;
             return Err(r.error(
                 next,
                 &format!("{n_bonds} lines in the Bonds section (header says {n_bonds} bonds)"),
-                format!("{} bond lines", bonds_raw.len()).as_bytes(),
+                format!("{} bond lines; {ended}", bonds_raw.len()).as_bytes(),
             ));
         }
         // Sort by id; ids are freed before the other columns are permuted.
@@ -339,9 +363,10 @@ impl FrameParser for DataParser {
                         .ok()
                         .and_then(|t| self.opts.type_element(t))
                         .or_else(|| {
-                            masses
-                                .get(&i64::from(ty))
-                                .and_then(|&m| elements::by_mass(m as f32))
+                            let m = *masses.get(&i64::from(ty))?;
+                            // g/mol first; kg/mol (SI files) only when nothing matches.
+                            elements::by_mass(m as f32)
+                                .or_else(|| elements::by_mass((m * 1000.0) as f32))
                         });
                     let z = z.unwrap_or_else(|| {
                         self.warnings.push(format!(

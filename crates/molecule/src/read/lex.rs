@@ -89,7 +89,7 @@ impl LineReader {
                 Err(e) => {
                     return Err(ReadError::Io {
                         path: self.path.to_path_buf(),
-                        source: e,
+                        error: e,
                     })
                 }
             }

@@ -134,14 +134,15 @@ impl ReadOptions {
 /// what was expected.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
-    /// Operating-system or decompression error.
-    #[error("{}: {source}", .path.display())]
+    /// Operating-system or decompression error. The message includes the underlying
+    /// error's text, so it is deliberately not also exposed as `source()` (an error chain
+    /// printer would repeat it).
+    #[error("{}: {error}", .path.display())]
     Io {
         /// File being read.
         path: PathBuf,
         /// Underlying error.
-        #[source]
-        source: io::Error,
+        error: io::Error,
     },
     /// Malformed content.
     #[error("{}:{line}: frame {frame}: expected {expected}, found {found}", .path.display())]
@@ -165,11 +166,31 @@ pub enum ReadError {
         /// Format that was expected.
         format: Format,
     },
+    /// No frame of the expected format, and the content looks like another format.
+    #[error("{}: no {format} data found; the content looks like {looks_like} (pass --format {looks_like})", .path.display())]
+    WrongFormat {
+        /// File being read.
+        path: PathBuf,
+        /// Format that was expected (from the extension or `--format`).
+        format: Format,
+        /// Format the content was sniffed as.
+        looks_like: Format,
+    },
     /// Format could not be determined.
     #[error("{}: cannot tell the format from the file name or content; pass --format (xyz, pdb, lammps-dump, lammps-data, gro)", .path.display())]
     UnknownFormat {
         /// File being read.
         path: PathBuf,
+    },
+    /// A frame counted from the end (`-k`) before the first frame.
+    #[error("{}: frame -{back} does not exist (the file has {count} frame(s))", .path.display())]
+    NoSuchFrameFromEnd {
+        /// File being read.
+        path: PathBuf,
+        /// Requested frame, counted from the end (1 = last).
+        back: usize,
+        /// Number of frames in the file.
+        count: usize,
     },
     /// `read_frame(k)` past the end.
     #[error("{}: frame {frame} does not exist (the file has {count} frame(s))", .path.display())]
@@ -181,6 +202,55 @@ pub enum ReadError {
         /// Number of frames in the file.
         count: usize,
     },
+}
+
+impl ReadError {
+    /// True for a frame cut off by the end of the file (a parse error whose found text is
+    /// "end of file ..."): the trajectory's truncated tail.
+    pub fn is_truncation(&self) -> bool {
+        matches!(self, ReadError::Parse { found, .. }
+            if found.trim_start_matches('\'').starts_with("end of file"))
+    }
+}
+
+/// A frame of a trajectory: `FromStart(k)` is the 0-based frame `k`, `FromEnd(k)` the k-th
+/// frame from the end (`FromEnd(1)` = last). Parsed from an integer: `2` → `FromStart(2)`,
+/// `-1` → `FromEnd(1)`. Resolved by [`Trajectory::resolve_frame`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameIndex {
+    /// 0-based index from the first frame.
+    FromStart(usize),
+    /// 1-based index from the last frame.
+    FromEnd(usize),
+}
+
+impl From<i64> for FrameIndex {
+    fn from(k: i64) -> FrameIndex {
+        if k < 0 {
+            FrameIndex::FromEnd(k.unsigned_abs() as usize)
+        } else {
+            FrameIndex::FromStart(k as usize)
+        }
+    }
+}
+
+impl FromStr for FrameIndex {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        s.trim()
+            .parse::<i64>()
+            .map(FrameIndex::from)
+            .map_err(|_| format!("'{s}': expected a frame number (0 = first, -1 = last)"))
+    }
+}
+
+impl fmt::Display for FrameIndex {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FrameIndex::FromStart(k) => write!(f, "{k}"),
+            FrameIndex::FromEnd(k) => write!(f, "-{k}"),
+        }
+    }
 }
 
 /// A parser for one format: reads frames from a [`LineReader`].
@@ -208,9 +278,9 @@ fn new_parser(format: Format, opts: &ReadOptions) -> Box<dyn FrameParser> {
 /// Open `path` as a byte stream (gzip-decoded if it starts with the gzip magic), positioned at
 /// byte `offset` of the *decoded* stream (seek for plain files, skip for gzip).
 fn open_stream(path: &Path, offset: u64) -> Result<(Box<dyn Read + Send>, bool), ReadError> {
-    let io_err = |source| ReadError::Io {
+    let io_err = |error| ReadError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     };
     let mut f = File::open(path).map_err(io_err)?;
     let mut magic = [0u8; 2];
@@ -242,18 +312,37 @@ fn open_stream(path: &Path, offset: u64) -> Result<(Box<dyn Read + Send>, bool),
 fn sniff(path: &Path) -> Result<Option<Format>, ReadError> {
     let (src, _) = open_stream(path, 0)?;
     let mut r = LineReader::new(src, Arc::from(path));
-    let mut first = None;
-    while let Some((_, line)) = r.next_line()? {
-        let t = lex::trim(line);
-        if !t.is_empty() {
-            first = Some(t.to_vec());
-            break;
+    // The first lines (raw, up to 40) for the format-specific checks below.
+    let mut head: Vec<Vec<u8>> = Vec::new();
+    while head.len() < 40 {
+        match r.next_line() {
+            Ok(Some((_, line))) => head.push(lex::trim(line).to_vec()),
+            Ok(None) => break,
+            Err(e) if head.is_empty() => return Err(e),
+            Err(_) => break,
         }
     }
-    let Some(t) = first else { return Ok(None) };
-    Ok(if t.starts_with(b"ITEM:") {
+    Ok(sniff_lines(&head))
+}
+
+/// Format guessed from the first lines of a file (trimmed), if any.
+fn sniff_lines(head: &[Vec<u8>]) -> Option<Format> {
+    let t = head.iter().find(|l| !l.is_empty())?;
+    let is_count = |l: &[u8]| lex::parse_usize(l).is_some();
+    // .gro: title, atom count, then fixed-column atom lines (>= 44 columns).
+    if head.len() >= 3 && !is_count(&head[0]) && is_count(&head[1]) && head[2].len() >= 36 {
+        return Some(Format::Gro);
+    }
+    // LAMMPS data: title, then header lines such as "N atoms".
+    if head.iter().skip(1).any(|l| {
+        let w: Vec<&[u8]> = lex::fields(l).collect();
+        w.len() == 2 && w[1] == b"atoms" && is_count(w[0])
+    }) {
+        return Some(Format::LammpsData);
+    }
+    if t.starts_with(b"ITEM:") {
         Some(Format::LammpsDump)
-    } else if lex::parse_usize(&t).is_some() {
+    } else if lex::parse_usize(t).is_some() {
         Some(Format::Xyz)
     } else if [
         &b"ATOM"[..],
@@ -271,7 +360,23 @@ fn sniff(path: &Path) -> Result<Option<Format>, ReadError> {
         Some(Format::Pdb)
     } else {
         None
-    })
+    }
+}
+
+/// The error for a file with no frame of `format`: [`ReadError::WrongFormat`] when the
+/// content sniffs as another format, else [`ReadError::Empty`].
+fn empty_error(path: &Path, format: Format) -> ReadError {
+    match sniff(path) {
+        Ok(Some(f)) if f != format => ReadError::WrongFormat {
+            path: path.to_path_buf(),
+            format,
+            looks_like: f,
+        },
+        _ => ReadError::Empty {
+            path: path.to_path_buf(),
+            format,
+        },
+    }
 }
 
 /// Open a trajectory. Frames are parsed lazily; see [`Trajectory`].
@@ -296,6 +401,8 @@ pub fn open(path: &Path, opts: &ReadOptions) -> Result<Trajectory, ReadError> {
         frame_starts: None,
         count: None,
         failed: false,
+        tail_warning: None,
+        all_warnings: Vec::new(),
     })
 }
 
@@ -306,6 +413,11 @@ pub fn read_first(path: &Path, opts: &ReadOptions) -> Result<Molecule, ReadError
 }
 
 /// A lazily read sequence of frames from one file.
+///
+/// Truncated tail: a frame after the first that the end of the file cuts off
+/// ([`ReadError::is_truncation`]) is not a frame. Iteration, [`Trajectory::read_frame`] and
+/// [`Trajectory::count_frames`] all stop before it and add a warning naming the line, so
+/// every caller sees the same frame count. (A cut first frame stays an error.)
 ///
 /// Iterating yields `Result<Molecule, ReadError>` one frame at a time; iteration stops after
 /// the first error. [`Trajectory::count_frames`] scans the file once (skipping atom lines
@@ -323,6 +435,10 @@ pub struct Trajectory {
     frame_starts: Option<Vec<(u64, u64)>>,
     count: Option<usize>,
     failed: bool,
+    /// Warning about a truncated last frame, once seen.
+    tail_warning: Option<String>,
+    /// Parser warnings plus `tail_warning`, rebuilt by [`Trajectory::warnings`].
+    all_warnings: Vec<String>,
 }
 
 impl Trajectory {
@@ -341,9 +457,47 @@ impl Trajectory {
         self.gz
     }
 
-    /// Warnings so far (e.g. unknown element symbols, mapped to Z = 0).
-    pub fn warnings(&self) -> &[String] {
-        self.parser.warnings()
+    /// Warnings so far (e.g. unknown element symbols, mapped to Z = 0; a truncated last
+    /// frame).
+    pub fn warnings(&mut self) -> &[String] {
+        self.all_warnings = self.parser.warnings().to_vec();
+        if let Some(w) = &self.tail_warning {
+            self.all_warnings.push(w.clone());
+        }
+        &self.all_warnings
+    }
+
+    fn note_truncated_tail(&mut self, e: &ReadError, complete: usize) {
+        if self.tail_warning.is_none() {
+            self.tail_warning = Some(format!(
+                "{e}; the file ends inside frame {complete}, which is ignored ({complete} complete frame(s))"
+            ));
+        }
+    }
+
+    /// The 0-based index of `idx`; [`FrameIndex::FromEnd`] counts the frames first.
+    /// Errors when the frame does not exist, naming the frame count.
+    pub fn resolve_frame(&mut self, idx: FrameIndex) -> Result<usize, ReadError> {
+        match idx {
+            FrameIndex::FromStart(k) => Ok(k),
+            FrameIndex::FromEnd(back) => {
+                let count = self.count_frames()?;
+                if back == 0 || back > count {
+                    return Err(ReadError::NoSuchFrameFromEnd {
+                        path: self.path.to_path_buf(),
+                        back,
+                        count,
+                    });
+                }
+                Ok(count - back)
+            }
+        }
+    }
+
+    /// Read the frame `idx` (from the start or the end, see [`FrameIndex`]).
+    pub fn read_frame_at(&mut self, idx: FrameIndex) -> Result<Molecule, ReadError> {
+        let k = self.resolve_frame(idx)?;
+        self.read_frame(k)
     }
 
     /// Number of frames (scans the whole file once; cached). An empty file is an error.
@@ -358,16 +512,18 @@ impl Trajectory {
         loop {
             r.frame = starts.len();
             let at = (r.offset(), r.line_no());
-            if !p.skip_frame(&mut r)? {
-                break;
+            match p.skip_frame(&mut r) {
+                Ok(true) => starts.push(at),
+                Ok(false) => break,
+                Err(e) if e.is_truncation() && !starts.is_empty() => {
+                    self.note_truncated_tail(&e, starts.len());
+                    break;
+                }
+                Err(e) => return Err(e),
             }
-            starts.push(at);
         }
         if starts.is_empty() {
-            return Err(ReadError::Empty {
-                path: self.path.to_path_buf(),
-                format: self.format,
-            });
+            return Err(empty_error(&self.path, self.format));
         }
         self.count = Some(starts.len());
         self.frame_starts = Some(starts);
@@ -381,10 +537,7 @@ impl Trajectory {
         }
         match self.next_frame()? {
             Some(m) => Ok(m),
-            None if k == 0 => Err(ReadError::Empty {
-                path: self.path.to_path_buf(),
-                format: self.format,
-            }),
+            None if k == 0 => Err(empty_error(&self.path, self.format)),
             None => Err(ReadError::NoSuchFrame {
                 path: self.path.to_path_buf(),
                 frame: k,
@@ -420,7 +573,14 @@ impl Trajectory {
         self.next_index = 0;
         while self.next_index < k {
             self.reader.frame = self.next_index;
-            if !self.parser.skip_frame(&mut self.reader)? {
+            let more = match self.parser.skip_frame(&mut self.reader) {
+                Err(e) if e.is_truncation() && self.next_index > 0 => {
+                    self.note_truncated_tail(&e, self.next_index);
+                    false
+                }
+                other => other?,
+            };
+            if !more {
                 return Err(ReadError::NoSuchFrame {
                     path: self.path.to_path_buf(),
                     frame: k,
@@ -445,11 +605,13 @@ impl Trajectory {
             Ok(None) => {
                 if self.next_index == 0 {
                     self.failed = true;
-                    return Err(ReadError::Empty {
-                        path: self.path.to_path_buf(),
-                        format: self.format,
-                    });
+                    return Err(empty_error(&self.path, self.format));
                 }
+                Ok(None)
+            }
+            Err(e) if e.is_truncation() && self.next_index > 0 => {
+                self.failed = true;
+                self.note_truncated_tail(&e, self.next_index);
                 Ok(None)
             }
             Err(e) => {
@@ -481,9 +643,12 @@ pub fn parse_bytes(
     let mut out = Vec::new();
     loop {
         r.frame = out.len();
-        match p.next_frame(&mut r)? {
-            Some(m) => out.push(m),
-            None => break,
+        match p.next_frame(&mut r) {
+            Ok(Some(m)) => out.push(m),
+            Ok(None) => break,
+            // Same truncated-tail rule as [`Trajectory`].
+            Err(e) if e.is_truncation() && !out.is_empty() => break,
+            Err(e) => return Err(e),
         }
     }
     if out.is_empty() {

@@ -10,10 +10,10 @@ use crate::settings::SceneSettings;
 use crate::SceneError;
 
 /// Binary BVH nodes per primitive. Measured on nanobowl, ns90k and sio2 (binned SAH builder,
-/// leaves of ≤ 4): 0.64-0.67; leaves hold ~3 primitives on average.
-pub const BVH_NODES_PER_PRIM: f64 = 0.66;
-/// 8-wide BVH nodes per primitive, measured as above (0.08-0.09).
-pub const WIDE_NODES_PER_PRIM: f64 = 0.085;
+/// leaves of ≤ 4); ns90k and sio2 still to be measured.
+pub const BVH_NODES_PER_PRIM: f64 = 0.70;
+/// 8-wide BVH nodes per primitive, measured on nanobowl (0.0972).
+pub const WIDE_NODES_PER_PRIM: f64 = 0.097;
 /// Bytes of a binary BVH node.
 const NODE_BYTES: u64 = 32;
 /// Bytes of an 8-wide node.
@@ -72,7 +72,7 @@ impl MemoryEstimate {
         }
         if let Some(vs) = &settings.volume {
             let grid = density_grid(m, vs)?;
-            e.volume = grid.voxel_count() * vs.format.bytes_per_voxel();
+            e.volume = grid.voxel_count() * vs.format.bytes_per_voxel() + 4;
             e.volume_dims = Some(grid.dims);
             e.macrocells = macrocell_count(&grid) * 8;
             if let Some(lv) = &vs.light_volume {

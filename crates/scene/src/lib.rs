@@ -1,16 +1,32 @@
-//! Scene assembly (paper §4.1): from atoms and typed settings to what the renderer traces —
-//! the ball-and-stick [`Model`] (geometry, BVH, per-slot colours, bounding sphere) — and the
-//! [`Camera`] with the paper's far/close views (Table 3).
+//! Scene assembly (paper §4.1): from a molecule frame and typed [`SceneSettings`] to what the
+//! renderer traces — bonds, the ball-and-stick [`Model`] (geometry, BVH, per-slot colours),
+//! the density volume with macrocells and the light volume ([`Scene::build`]) — with one
+//! [`MemoryEstimate`] checked before allocation, and camera fitting ([`bounding_sphere`],
+//! [`Camera::fit`]) with the paper's far/close views (Table 3).
 //!
-//! Units: positions and radii in Ångström (Å); field of view in degrees.
+//! Units: positions and radii in Ångström (Å); field of view and orbit angles in degrees.
+#![warn(missing_docs)]
 
+mod build;
 mod camera;
 mod colormap;
+mod error;
+mod fit;
+mod memory;
 mod model;
+mod settings;
 
+pub use build::{DensityVolume, Scene, Stage, Timings};
 pub use camera::{Camera, Projection, View};
 pub use colormap::{viridis, Colormap};
+pub use error::SceneError;
+pub use fit::{bounding_sphere, Orbit, Sphere, ATOM_SPHERE_PAD};
+pub use memory::{MemoryEstimate, BVH_NODES_PER_PRIM, WIDE_NODES_PER_PRIM};
 pub use model::{Coloring, Model, ModelOptions, Style};
+pub use settings::{
+    BondSettings, BondSource, ColorBy, LightVolumeSettings, ModelSettings, RadiusKind,
+    SceneSettings, VolumeSettings, LIGHT_VOLUME_STRIDE,
+};
 
 /// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).
 pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {

@@ -1,0 +1,365 @@
+//! `Scene::build`: a molecule frame and [`SceneSettings`] to bonds, the ball-and-stick model
+//! with its BVH, the density volume with macrocells and classified transfer function, and the
+//! light volume (paper §4.1 steps 3-5), with per-stage timings and a memory check first.
+
+use std::time::Instant;
+
+use molecule::bonds::build_bonds;
+use molecule::{elements, Molecule};
+use spmd::Isa;
+use volume::{
+    build_density, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells, MarchOptions,
+    Volume, VolumeScene,
+};
+
+use crate::fit::{bounding_sphere, Sphere};
+use crate::memory::MemoryEstimate;
+use crate::model::{Coloring, Model, ModelOptions, Style};
+use crate::settings::{
+    BondSettings, BondSource, ColorBy, ModelSettings, RadiusKind, SceneSettings, VolumeSettings,
+};
+use crate::SceneError;
+
+/// A stage of [`Scene::build`], reported to the progress callback when it starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Bond detection.
+    Bonds,
+    /// Model geometry and BVH (and the wide BVH when used).
+    Model,
+    /// Density volume.
+    Volume,
+    /// Macrocells and transfer-function classification.
+    Macrocells,
+    /// Light volume.
+    LightVolume,
+}
+
+/// Wall time of each stage (seconds; 0 for stages not run).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Bond detection.
+    pub bonds: f64,
+    /// Model geometry and BVH (the BVH alone: `model.bvh.stats.build_time`).
+    pub model: f64,
+    /// Density volume.
+    pub volume: f64,
+    /// Macrocells and transfer-function classification.
+    pub macrocells: f64,
+    /// Light volume.
+    pub light_volume: f64,
+}
+
+/// The density volume with what the marcher needs besides its options.
+#[derive(Clone, Debug)]
+pub struct DensityVolume {
+    /// The grid of RBF density.
+    pub volume: Volume,
+    /// Its macrocells.
+    pub cells: Macrocells,
+    /// The transfer function classified over `[0, volume.max_value]`.
+    pub tf: ClassifiedTf,
+}
+
+/// Everything the renderer traces for one frame of a molecule.
+#[derive(Debug)]
+pub struct Scene {
+    /// The settings it was built with (reused by [`Scene::rebuild`]).
+    pub settings: SceneSettings,
+    /// Bonds (pairs of atom indices; empty without a model).
+    pub bonds: Vec<[u32; 2]>,
+    /// Ball-and-stick model (geometry + BVH).
+    pub model: Option<Model>,
+    /// Density volume.
+    pub volume: Option<DensityVolume>,
+    /// Light volume of volumetric shadows.
+    pub light_volume: Option<LightVolume>,
+    /// The sphere cameras are fitted to ([`bounding_sphere`]).
+    pub sphere: Sphere,
+    /// The estimate checked against the budget before building.
+    pub estimate: MemoryEstimate,
+    /// Per-stage wall times.
+    pub timings: Timings,
+    /// Per-atom radius and colour scratch, reused by [`Scene::rebuild`].
+    scratch: (Vec<f32>, Vec<u32>),
+}
+
+impl Scene {
+    /// Builds the scene of `m` with backend `isa` (density and light volume kernels).
+    pub fn build(isa: Isa, m: &Molecule, settings: &SceneSettings) -> Result<Scene, SceneError> {
+        Scene::build_with(isa, m, settings, &|_| {})
+    }
+
+    /// [`Scene::build`] calling `progress` as each stage starts.
+    pub fn build_with(
+        isa: Isa,
+        m: &Molecule,
+        settings: &SceneSettings,
+        progress: &dyn Fn(Stage),
+    ) -> Result<Scene, SceneError> {
+        let mut s = Scene {
+            settings: settings.clone(),
+            bonds: Vec::new(),
+            model: None,
+            volume: None,
+            light_volume: None,
+            sphere: Sphere {
+                center: [0.0; 3],
+                radius: 1.0,
+            },
+            estimate: MemoryEstimate::default(),
+            timings: Timings::default(),
+            scratch: (Vec::new(), Vec::new()),
+        };
+        s.rebuild_with(isa, m, progress)?;
+        Ok(s)
+    }
+
+    /// Rebuilds for the next trajectory frame `m` with the same settings. Reused: the bond
+    /// Vec (refilled in place for file bonds) and the per-atom radius and colour scratch; the
+    /// BVH, volume and light volume are built anew (their builders allocate).
+    pub fn rebuild(&mut self, isa: Isa, m: &Molecule) -> Result<(), SceneError> {
+        self.rebuild_with(isa, m, &|_| {})
+    }
+
+    /// [`Scene::rebuild`] calling `progress` as each stage starts.
+    pub fn rebuild_with(
+        &mut self,
+        isa: Isa,
+        m: &Molecule,
+        progress: &dyn Fn(Stage),
+    ) -> Result<(), SceneError> {
+        if m.is_empty() {
+            return Err(SceneError::NoAtoms);
+        }
+        self.model = None;
+        self.volume = None;
+        self.light_volume = None;
+        self.timings = Timings::default();
+        let st = &self.settings;
+        if let Some(ms) = &st.model {
+            check_model(ms)?;
+            progress(Stage::Bonds);
+            let t = Instant::now();
+            fill_bonds(&st.bonds, m, &mut self.bonds)?;
+            self.timings.bonds = t.elapsed().as_secs_f64();
+        } else {
+            self.bonds.clear();
+        }
+        // Check the budget before the large allocations (the frame and bonds already exist).
+        self.estimate = MemoryEstimate::new(m, self.bonds.len(), st)?;
+        let needed = self.estimate.total() - self.estimate.atoms - self.estimate.bonds;
+        if let Some(budget) = st.budget_bytes.or_else(volume::default_budget_bytes) {
+            if needed > budget {
+                return Err(SceneError::TooLarge {
+                    needed,
+                    budget,
+                    breakdown: self.estimate.breakdown(),
+                });
+            }
+        }
+        if let Some(ms) = &st.model {
+            progress(Stage::Model);
+            let t = Instant::now();
+            let model = build_model(m, &self.bonds, ms, &mut self.scratch)?;
+            if ms.wide_bvh {
+                model.wide();
+            }
+            self.model = Some(model);
+            self.timings.model = t.elapsed().as_secs_f64();
+        }
+        if let Some(vs) = &st.volume {
+            progress(Stage::Volume);
+            let t = Instant::now();
+            let volume = build_volume(isa, m, vs, st.budget_bytes, &mut self.scratch.0)?;
+            self.timings.volume = t.elapsed().as_secs_f64();
+            progress(Stage::Macrocells);
+            let t = Instant::now();
+            let cells = Macrocells::build(&volume);
+            let tf = ClassifiedTf::new(&vs.tf, 0.0, volume.max_value, vs.step_voxels);
+            self.timings.macrocells = t.elapsed().as_secs_f64();
+            let d = DensityVolume { volume, cells, tf };
+            if let Some(lv) = &vs.light_volume {
+                progress(Stage::LightVolume);
+                let t = Instant::now();
+                let scene = VolumeScene::new(&d.volume, &d.cells, &d.tf, MarchOptions::default());
+                self.light_volume = Some(LightVolume::build(isa, &scene, lv.shadows(), lv.stride));
+                self.timings.light_volume = t.elapsed().as_secs_f64();
+            }
+            self.volume = Some(d);
+        }
+        self.sphere = bounding_sphere(m, self.model.as_ref());
+        Ok(())
+    }
+
+    /// The marcher's view of the volume with options `opts`, with the light volume attached
+    /// when it was built for `opts.shadows`.
+    pub fn volume_scene(&self, opts: MarchOptions) -> Option<VolumeScene<'_>> {
+        let d = self.volume.as_ref()?;
+        let vs = VolumeScene::new(&d.volume, &d.cells, &d.tf, opts);
+        Some(match &self.light_volume {
+            Some(lv) if opts.shadows == Some(lv.shadows) => vs.with_light_volume(lv),
+            _ => vs,
+        })
+    }
+}
+
+/// Rejects out-of-range model settings.
+fn check_model(ms: &ModelSettings) -> Result<(), SceneError> {
+    if !(ms.radius_scale > 0.0 && ms.radius_scale.is_finite()) {
+        return Err(SceneError::BadSetting {
+            name: "radius-scale",
+            expected: "a positive number",
+            value: ms.radius_scale,
+        });
+    }
+    if !(ms.stick_radius > 0.0 && ms.stick_radius.is_finite()) {
+        return Err(SceneError::BadSetting {
+            name: "stick-radius",
+            expected: "a positive number of Å",
+            value: ms.stick_radius,
+        });
+    }
+    Ok(())
+}
+
+impl BondSettings {
+    /// The bonds of `m` (pairs `i < j`, sorted, for [`BondSource::Auto`]).
+    pub fn build(&self, m: &Molecule) -> Result<Vec<[u32; 2]>, SceneError> {
+        let mut out = Vec::new();
+        fill_bonds(self, m, &mut out)?;
+        Ok(out)
+    }
+}
+
+/// Replaces `out` with the bonds of `m`.
+fn fill_bonds(b: &BondSettings, m: &Molecule, out: &mut Vec<[u32; 2]>) -> Result<(), SceneError> {
+    match b.source {
+        BondSource::Auto => *out = build_bonds(m, &b.options),
+        BondSource::File => {
+            let fb = m.file_bonds.as_ref().ok_or(SceneError::NoFileBonds)?;
+            out.clear();
+            out.extend_from_slice(fb);
+        }
+        BondSource::None => out.clear(),
+    }
+    Ok(())
+}
+
+/// Bonds drawn and BVH primitives of a model of `atoms` atoms and `bonds` bonds.
+pub(crate) fn model_prim_count(atoms: usize, bonds: usize, ms: &ModelSettings) -> (usize, usize) {
+    let bonds = if ms.style == Style::Spheres { 0 } else { bonds };
+    let balls = if ms.style == Style::Licorice {
+        0
+    } else {
+        atoms
+    };
+    (bonds, balls + bonds)
+}
+
+/// The ball-and-stick model of `m` with `bonds`; `scratch` holds the per-atom radii and
+/// colours between frames.
+pub(crate) fn build_model(
+    m: &Molecule,
+    bonds: &[[u32; 2]],
+    ms: &ModelSettings,
+    scratch: &mut (Vec<f32>, Vec<u32>),
+) -> Result<Model, SceneError> {
+    check_model(ms)?;
+    let (radius, colors) = scratch;
+    radius.clear();
+    radius.extend(m.elements.iter().map(|&z| {
+        let e = elements::element(z);
+        match ms.radius {
+            RadiusKind::Covalent => e.covalent_radius,
+            RadiusKind::Vdw => e.vdw_radius,
+        }
+    }));
+    colors.clear();
+    colors.extend(m.elements.iter().map(|&z| {
+        let [r, g, b] = elements::element(z).color;
+        crate::rgba(r, g, b, 255)
+    }));
+    let coloring = match &ms.color {
+        ColorBy::Element => Coloring::PerAtom,
+        ColorBy::Column { name, colormap } => {
+            let values = m.scalar(name).ok_or_else(|| SceneError::NoSuchColumn {
+                name: name.clone(),
+                available: m.scalars.iter().map(|(n, _)| n.clone()).collect(),
+            })?;
+            Coloring::Scalar {
+                values: values.to_vec(),
+                colormap: *colormap,
+                range: None,
+            }
+        }
+    };
+    let opt = ModelOptions {
+        radius_scale: ms.radius_scale,
+        stick_radius: ms.stick_radius,
+        style: ms.style,
+        coloring,
+    };
+    Ok(Model::new(&m.x, &m.y, &m.z, radius, colors, bonds, &opt))
+}
+
+impl ModelSettings {
+    /// The ball-and-stick model of `m` with `bonds` (what [`Scene::build`] builds).
+    pub fn build_model(&self, m: &Molecule, bonds: &[[u32; 2]]) -> Result<Model, SceneError> {
+        build_model(m, bonds, self, &mut (Vec::new(), Vec::new()))
+    }
+}
+
+/// Covalent radii of the atoms (Å): the RBF widths of the density.
+fn density_radii(m: &Molecule, out: &mut Vec<f32>) {
+    out.clear();
+    out.extend(
+        m.elements
+            .iter()
+            .map(|&z| elements::element(z).covalent_radius),
+    );
+}
+
+/// The density lattice [`build_volume`] will use.
+pub(crate) fn density_grid(m: &Molecule, vs: &VolumeSettings) -> Result<Grid, SceneError> {
+    let mut r = Vec::new();
+    density_radii(m, &mut r);
+    Ok(Grid::for_atoms(
+        &m.x,
+        &m.y,
+        &m.z,
+        &r,
+        vs.voxels_per_angstrom,
+    )?)
+}
+
+/// The density volume of `m` (`radii` is scratch).
+fn build_volume(
+    isa: Isa,
+    m: &Molecule,
+    vs: &VolumeSettings,
+    budget_bytes: Option<u64>,
+    radii: &mut Vec<f32>,
+) -> Result<Volume, SceneError> {
+    density_radii(m, radii);
+    let params = DensityParams {
+        voxels_per_angstrom: vs.voxels_per_angstrom,
+        format: vs.format,
+        budget_bytes,
+    };
+    Ok(build_density(isa, &m.x, &m.y, &m.z, radii, &params)?)
+}
+
+impl VolumeSettings {
+    /// The density volume of `m` and its macrocells (what [`Scene::build`] builds; the
+    /// volume crate's own budget check applies).
+    pub fn build_density(
+        &self,
+        isa: Isa,
+        m: &Molecule,
+    ) -> Result<(Volume, Macrocells), SceneError> {
+        let v = build_volume(isa, m, self, None, &mut Vec::new())?;
+        let c = Macrocells::build(&v);
+        Ok((v, c))
+    }
+}

@@ -1,0 +1,45 @@
+//! Why a scene could not be built.
+
+/// Errors of [`crate::Scene::build`].
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A setting is out of range.
+    #[error("{name} must be {expected}, got {value}")]
+    BadSetting {
+        /// Setting (CLI flag name without dashes, e.g. `radius-scale`).
+        name: &'static str,
+        /// What it must be.
+        expected: &'static str,
+        /// The value given.
+        value: f32,
+    },
+    /// Colouring by a per-atom column the input does not have.
+    #[error("--color {name}: the input has no such per-atom column (it has: element{})",
+        available.iter().map(|a| format!(", {a}")).collect::<String>())]
+    NoSuchColumn {
+        /// Requested column.
+        name: String,
+        /// Columns the input has.
+        available: Vec<String>,
+    },
+    /// [`crate::BondSource::File`] but the input lists no bonds.
+    #[error("--bonds file: the input lists no bonds (LAMMPS data Bonds / PDB CONECT)")]
+    NoFileBonds,
+    /// No atoms.
+    #[error("no atoms to build a scene of")]
+    NoAtoms,
+    /// The estimate exceeds the memory budget (checked before anything large is allocated).
+    #[error("the scene would need about {} MB ({}), over the memory budget of {} MB",
+        needed / 1_000_000, breakdown, budget / 1_000_000)]
+    TooLarge {
+        /// Estimated bytes ([`crate::MemoryEstimate::total`]).
+        needed: u64,
+        /// Allowed bytes.
+        budget: u64,
+        /// The largest components, human readable.
+        breakdown: String,
+    },
+    /// The density volume failed (bad input, resolution or over its own budget).
+    #[error("building the density volume: {0}")]
+    Volume(#[from] volume::VolumeError),
+}

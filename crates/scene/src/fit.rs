@@ -1,0 +1,163 @@
+//! Camera fitting, done once for every command: the scene's bounding sphere and a camera on
+//! an orbit around its centre at the far/close distance of the paper's Table 3.
+
+use molecule::Molecule;
+
+use crate::camera::{Camera, View};
+use crate::model::Model;
+
+/// Padding (Å) of the atom-centre sphere when there is no geometry: about the support of the
+/// density around an atom (√2 × 1.4 Å).
+pub const ATOM_SPHERE_PAD: f32 = 2.0;
+
+/// A bounding sphere (Å).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre (Å).
+    pub center: [f32; 3],
+    /// Radius (Å, > 0).
+    pub radius: f32,
+}
+
+/// The sphere every command fits its camera to: the model's ([`Model::center`],
+/// [`Model::radius`]: centre of the BVH box, radius to the farthest ball surface) when there is
+/// a model, else the atom centres' (centre of their box) grown by [`ATOM_SPHERE_PAD`].
+pub fn bounding_sphere(m: &Molecule, model: Option<&Model>) -> Sphere {
+    if let Some(md) = model {
+        return Sphere {
+            center: md.center,
+            radius: md.radius,
+        };
+    }
+    let (lo, hi) = m.bounds();
+    let c = [
+        (lo[0] + hi[0]) * 0.5,
+        (lo[1] + hi[1]) * 0.5,
+        (lo[2] + hi[2]) * 0.5,
+    ];
+    let r2 = (0..m.len())
+        .map(|i| (m.x[i] - c[0]).powi(2) + (m.y[i] - c[1]).powi(2) + (m.z[i] - c[2]).powi(2))
+        .fold(0.0f32, f32::max);
+    Sphere {
+        center: c,
+        radius: r2.sqrt() + ATOM_SPHERE_PAD,
+    }
+}
+
+/// Where the camera sits on a sphere around the scene centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    /// Rotation about +y (degrees); 0 looks along −z, 90 looks along −x (eye on +x).
+    pub azimuth_deg: f32,
+    /// Height above the x-z plane (degrees, −90..90); positive looks down.
+    pub elevation_deg: f32,
+    /// Zoom factor (> 0): the eye distance is divided by it.
+    pub zoom: f32,
+}
+
+impl Default for Orbit {
+    fn default() -> Self {
+        Orbit {
+            azimuth_deg: 0.0,
+            elevation_deg: 0.0,
+            zoom: 1.0,
+        }
+    }
+}
+
+impl Camera {
+    /// Fits a perspective camera to `sphere`: the [`View`] distance ([`Camera::view`]) divided
+    /// by `orbit.zoom`, from direction (azimuth, elevation) around the centre, vertical field
+    /// of view `fov_y_deg`, image `aspect` = width/height. `Orbit::default()` is exactly
+    /// [`Camera::view`] (eye on +z, +y up).
+    pub fn fit(view: View, sphere: Sphere, fov_y_deg: f32, aspect: f32, orbit: Orbit) -> Camera {
+        let base = Camera::view(view, sphere.center, sphere.radius, fov_y_deg, aspect);
+        if orbit == Orbit::default() {
+            return base;
+        }
+        let c = sphere.center;
+        let dist = (0..3)
+            .map(|a| (base.eye[a] as f64 - c[a] as f64).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / orbit.zoom.max(1e-6) as f64;
+        let (az, el) = (
+            (orbit.azimuth_deg as f64).to_radians(),
+            (orbit.elevation_deg as f64).to_radians(),
+        );
+        let dir = [az.sin() * el.cos(), el.sin(), az.cos() * el.cos()];
+        let up = [-az.sin() * el.sin(), el.cos(), -az.cos() * el.sin()];
+        let eye = core::array::from_fn(|a| (c[a] as f64 + dir[a] * dist) as f32);
+        Camera::look_at(eye, c, up.map(|u| u as f32), fov_y_deg)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: [f32; 3], b: [f32; 3]) -> bool {
+        (0..3).all(|k| (a[k] - b[k]).abs() < 1e-4)
+    }
+
+    #[test]
+    fn default_orbit_is_the_plus_z_view_bit_for_bit() {
+        let s = Sphere {
+            center: [1.5, -2.25, 3.0],
+            radius: 17.3,
+        };
+        for view in [View::Far, View::Close] {
+            let a = Camera::fit(view, s, 45.0, 1.5, Orbit::default());
+            let b = Camera::view(view, s.center, s.radius, 45.0, 1.5);
+            assert_eq!(a, b);
+            assert!(a.eye[2] > s.center[2]);
+        }
+    }
+
+    #[test]
+    fn orbit_moves_the_eye_around_the_centre() {
+        let s = Sphere {
+            center: [0.0, 0.0, 0.0],
+            radius: 10.0,
+        };
+        let far = Camera::view(View::Far, s.center, s.radius, 45.0, 1.0);
+        let d = far.eye[2];
+        // Azimuth 90: eye on +x looking along -x.
+        let o = Orbit {
+            azimuth_deg: 90.0,
+            ..Orbit::default()
+        };
+        let c = Camera::fit(View::Far, s, 45.0, 1.0, o);
+        assert!(close(c.eye, [d, 0.0, 0.0]), "{:?}", c.eye);
+        assert!(close(c.forward, [-1.0, 0.0, 0.0]));
+        assert!(close(c.up, [0.0, 1.0, 0.0]));
+        // Elevation 90: eye above, looking down; zoom 2 halves the distance.
+        let o = Orbit {
+            elevation_deg: 90.0,
+            zoom: 2.0,
+            ..Orbit::default()
+        };
+        let c = Camera::fit(View::Far, s, 45.0, 1.0, o);
+        assert!(close(c.eye, [0.0, d / 2.0, 0.0]), "{:?}", c.eye);
+        assert!(close(c.forward, [0.0, -1.0, 0.0]));
+        assert!(close(c.up, [0.0, 0.0, -1.0]), "{:?}", c.up);
+    }
+
+    #[test]
+    fn atom_sphere_contains_every_atom_with_the_pad() {
+        let mut m = Molecule::with_capacity(3);
+        m.push([0.0, 0.0, 0.0], 6);
+        m.push([4.0, 0.0, 0.0], 6);
+        m.push([2.0, 3.0, -1.0], 8);
+        let s = bounding_sphere(&m, None);
+        assert_eq!(s.center, [2.0, 1.5, -0.5]);
+        for i in 0..m.len() {
+            let p = m.position(i);
+            let d = (0..3)
+                .map(|k| (p[k] - s.center[k]).powi(2))
+                .sum::<f32>()
+                .sqrt();
+            assert!(d + ATOM_SPHERE_PAD <= s.radius + 1e-5);
+        }
+    }
+}

@@ -1,0 +1,165 @@
+//! Typed scene settings: what to build from a molecule frame (model, bonds, volume). The
+//! defaults are the `bnsview render` defaults.
+
+use molecule::bonds::BondOptions;
+use volume::{Light, TransferFunction, VolumeFormat, VolumeShadows};
+
+use crate::colormap::Colormap;
+use crate::model::Style;
+
+/// Which radius of the element table sizes the balls.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum RadiusKind {
+    /// Covalent radius (Cordero 2008).
+    #[default]
+    Covalent,
+    /// Van der Waals radius (Alvarez 2013).
+    Vdw,
+}
+
+/// How atoms are coloured.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum ColorBy {
+    /// CPK/Jmol colour of the element.
+    #[default]
+    Element,
+    /// A per-atom column of the input (e.g. `q`) through a colormap over its finite range.
+    Column {
+        /// Column name ([`molecule::Molecule::scalar`]).
+        name: String,
+        /// Colormap.
+        colormap: Colormap,
+    },
+}
+
+/// The ball-and-stick model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelSettings {
+    /// Drawing style.
+    pub style: Style,
+    /// Element radius used for the balls.
+    pub radius: RadiusKind,
+    /// Ball radius = element radius × this (dimensionless, > 0).
+    pub radius_scale: f32,
+    /// Stick radius (Å, > 0).
+    pub stick_radius: f32,
+    /// Colouring.
+    pub color: ColorBy,
+    /// The 8-wide BVH will be used (secondary or bounce rays `Wide`): counted by
+    /// [`crate::MemoryEstimate`] and built by [`crate::Scene::build`].
+    pub wide_bvh: bool,
+}
+
+impl Default for ModelSettings {
+    fn default() -> Self {
+        ModelSettings {
+            style: Style::BallAndStick,
+            radius: RadiusKind::Covalent,
+            radius_scale: 0.5,
+            stick_radius: 0.15,
+            color: ColorBy::Element,
+            wide_bvh: false,
+        }
+    }
+}
+
+/// Where bonds come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BondSource {
+    /// Geometric rule (uniform-grid neighbour search, [`molecule::bonds::build_bonds`]).
+    #[default]
+    Auto,
+    /// Bonds listed in the file (LAMMPS data `Bonds`, PDB `CONECT`); an error if there are none.
+    File,
+    /// No bonds.
+    None,
+}
+
+/// Bond detection.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct BondSettings {
+    /// Source.
+    pub source: BondSource,
+    /// Rule of [`BondSource::Auto`]: factor (default 1.15), cutoffs (Å), pbc.
+    pub options: BondOptions,
+}
+
+/// The light volume of volumetric shadows (paper §4.5): transmittance towards one light
+/// precomputed every `stride` density voxels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightVolumeSettings {
+    /// The light the shadows are cast from.
+    pub light: Light,
+    /// Step of the shadow rays (density voxels, > 0; CLI default 2).
+    pub step_voxels: f32,
+    /// Density voxels per light-volume cell: 1, 2, 4 or 8 (default [`LIGHT_VOLUME_STRIDE`]).
+    pub stride: usize,
+}
+
+/// Default stride (density voxels) of the light volume.
+pub const LIGHT_VOLUME_STRIDE: usize = 2;
+
+impl LightVolumeSettings {
+    /// The volume crate's shadow description (light and step) of these settings.
+    pub fn shadows(&self) -> VolumeShadows {
+        VolumeShadows {
+            light: self.light,
+            step_voxels: self.step_voxels,
+        }
+    }
+}
+
+/// The RBF density volume (paper §3.1) and what is derived from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeSettings {
+    /// Grid resolution (voxels per Å, > 0; the paper uses 4, and 1 for sio2 and anp3).
+    pub voxels_per_angstrom: f32,
+    /// Voxel storage.
+    pub format: VolumeFormat,
+    /// Transfer function, classified over `[0, max density]`.
+    pub tf: TransferFunction,
+    /// Ray-marching step the transfer function is classified for (voxels; CLI: 0.5).
+    pub step_voxels: f32,
+    /// Precomputed light volume (`None`: none, shadows march shadow rays if asked).
+    pub light_volume: Option<LightVolumeSettings>,
+}
+
+impl Default for VolumeSettings {
+    fn default() -> Self {
+        VolumeSettings {
+            voxels_per_angstrom: 4.0,
+            format: VolumeFormat::U8,
+            tf: TransferFunction::preset(volume::Preset::CoolWarm),
+            step_voxels: 0.5,
+            light_volume: None,
+        }
+    }
+}
+
+/// Everything [`crate::Scene::build`] needs besides the molecule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSettings {
+    /// Ball-and-stick model (`None`: no geometry, e.g. volume-only pictures).
+    pub model: Option<ModelSettings>,
+    /// Bonds (built only when there is a model).
+    pub bonds: BondSettings,
+    /// Density volume (`None`: none).
+    pub volume: Option<VolumeSettings>,
+    /// Refuse to build when the [`crate::MemoryEstimate`] total exceeds this many bytes
+    /// (`None`: 75 % of `MemAvailable`, no limit where that cannot be read).
+    pub budget_bytes: Option<u64>,
+    /// Framebuffer size (width, height pixels) counted by the estimate (`None`: not counted).
+    pub frame: Option<(u32, u32)>,
+}
+
+impl Default for SceneSettings {
+    fn default() -> Self {
+        SceneSettings {
+            model: Some(ModelSettings::default()),
+            bonds: BondSettings::default(),
+            volume: None,
+            budget_bytes: None,
+            frame: None,
+        }
+    }
+}

@@ -706,6 +706,6 @@ fn modality_name(args: &RenderArgs) -> String {
                 " shadows".into()
             }
         }
-        None => String::new(),
+        Some(Modality::Headlight) | None => String::new(),
     }
 }

@@ -14,7 +14,7 @@ pub struct InfoArgs {
     pub input: InputArgs,
     /// Voxels per Å for the volume memory estimate.
     #[arg(long, default_value_t = 4.0)]
-    pub voxels_per_angstrom: f64,
+    pub voxels_per_angstrom: f32,
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
@@ -33,18 +33,28 @@ fn emit(s: &str) {
     let _ = std::io::stdout().lock().write_all(s.as_bytes());
 }
 
-/// Padding (Å) around the atom bounds for the volume estimate.
-const VOLUME_PAD: f64 = 2.0;
-/// Bytes per BVH node assumed by the estimate.
-const BVH_NODE_BYTES: u64 = 32;
-
 /// Run `bnsview info`.
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     if args.input.file.is_none() && args.input.scene.is_none() {
         anyhow::bail!("give a molecule FILE or --scene NAME (nanobowl, ns90k, ns740k, sio2, anp3)");
     }
     let l = args.input.load(true)?;
+    // The same estimate `render` checks before allocating: default model (with the wide
+    // BVH) and a u8 volume at --voxels-per-angstrom.
+    let settings = scene::SceneSettings {
+        model: Some(scene::ModelSettings {
+            wide_bvh: true,
+            ..Default::default()
+        }),
+        volume: (!l.molecule.is_empty()).then(|| scene::VolumeSettings {
+            voxels_per_angstrom: args.voxels_per_angstrom,
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let est = scene::MemoryEstimate::new(&l.molecule, l.bonds.len(), &settings)?;
     report(
+        &est,
         &args,
         &l.source,
         &l.molecule,
@@ -61,6 +71,7 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
 
 #[allow(clippy::too_many_arguments)]
 fn report(
+    est: &scene::MemoryEstimate,
     args: &InfoArgs,
     source: &str,
     m: &Molecule,
@@ -75,18 +86,8 @@ fn report(
     let (lo, hi) = m.bounds();
     let n = m.len() as u64;
     let nb = bonds.len() as u64;
-    // BVH: ≤4 primitives per leaf → ~(atoms+bonds)/4 leaves, ~2× that many nodes.
-    let bvh_nodes = 2 * (n + nb).div_ceil(4);
-    let bvh_bytes = bvh_nodes * BVH_NODE_BYTES;
     let vpa = args.voxels_per_angstrom;
-    let dims: Vec<u64> = (0..3)
-        .map(|k| {
-            ((f64::from(hi[k] - lo[k]) + 2.0 * VOLUME_PAD) * vpa)
-                .ceil()
-                .max(1.0) as u64
-        })
-        .collect();
-    let voxels: u64 = dims.iter().product();
+    let dims = est.volume_dims.unwrap_or([0; 3]);
     let counts: Vec<(String, usize)> = m
         .element_counts()
         .into_iter()
@@ -111,9 +112,11 @@ fn report(
             "load_seconds": load_s,
             "bond_seconds": bond_s,
             "molecule_bytes": m.memory_bytes(),
-            "bvh_estimate": { "nodes": bvh_nodes, "bytes": bvh_bytes, "formula": "2*ceil((atoms+bonds)/4) nodes * 32 B" },
-            "volume_estimate": { "voxels_per_angstrom": vpa, "dims": dims, "voxels": voxels, "bytes_u8": voxels, "bytes_f32": voxels * 4,
-                                 "formula": "prod(ceil((max-min+2*2 A)*vpa)) voxels * 1 B (u8)" },
+            "memory_estimate": est.components().iter().map(|(k, b)| (k.to_string(), serde_json::json!(b))).chain([
+                ("total".to_string(), serde_json::json!(est.total())),
+                ("volume_dims".to_string(), serde_json::json!(dims)),
+                ("voxels_per_angstrom".to_string(), serde_json::json!(vpa)),
+            ]).collect::<serde_json::Map<_, _>>(),
             "warnings": warnings,
         });
         emit(&(serde_json::to_string_pretty(&v).unwrap_or_default() + "\n"));
@@ -175,17 +178,22 @@ fn report(
     );
     p!(
         out,
-        "BVH:       ~{:.1} MB (2*ceil((atoms+bonds)/4) = {bvh_nodes} nodes x 32 B)",
-        mb(bvh_bytes)
+        "memory:    ~{:.1} MB estimated for a default render with the wide BVH and a u8 volume:",
+        mb(est.total())
     );
+    for (name, bytes) in est.components() {
+        if bytes > 0 {
+            p!(out, "  {name:<12} {:>10.1} MB", mb(bytes));
+        }
+    }
     p!(
         out,
-        "volume:    {}x{}x{} voxels at {vpa} /Å (bounds + 2 Å pad): {:.1} MB as u8, {:.1} MB as f32",
+        "volume:    {}x{}x{} lattice points at {vpa} /Å: {:.1} MB as u8, {:.1} MB as f32",
         dims[0],
         dims[1],
         dims[2],
-        mb(voxels),
-        mb(voxels * 4)
+        mb(est.volume),
+        mb(est.volume * 4)
     );
     emit(&out);
 }

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use molecule::bonds::{try_build_bonds, BondOptions};
+use molecule::bonds::BondOptions;
 use molecule::read::{open, Format, FrameIndex, ReadOptions};
 use molecule::scenes::{try_generate, SceneName};
 use molecule::Molecule;
@@ -102,6 +102,18 @@ pub struct Loaded {
 }
 
 impl InputArgs {
+    /// Bond settings from the flags.
+    pub fn bond_settings(&self) -> anyhow::Result<scene::BondSettings> {
+        Ok(scene::BondSettings {
+            source: match self.bonds {
+                BondSource::Auto => scene::BondSource::Auto,
+                BondSource::File => scene::BondSource::File,
+                BondSource::None => scene::BondSource::None,
+            },
+            options: self.bond_options()?,
+        })
+    }
+
     /// Bond options from the flags.
     pub fn bond_options(&self) -> anyhow::Result<BondOptions> {
         Ok(BondOptions {
@@ -119,7 +131,20 @@ impl InputArgs {
     /// Reads (or generates) the frame and builds its bonds; `count_frames` also scans the
     /// whole file for the number of frames.
     pub fn load(&self, count_frames: bool) -> anyhow::Result<Loaded> {
-        let bond_opts = self.bond_options()?;
+        let bonds = self.bond_settings()?;
+        let mut l = self.load_frame(count_frames)?;
+        let pb = spinner(&format!("building bonds for {} atoms", l.molecule.len()));
+        let t1 = Instant::now();
+        l.bonds = bonds.build(&l.molecule)?;
+        l.bond_s = t1.elapsed().as_secs_f64();
+        pb.finish_and_clear();
+        Ok(l)
+    }
+
+    /// Reads (or generates) the frame without bonds (`bonds` empty, `bond_s` 0: the scene
+    /// builds them); `count_frames` as in [`InputArgs::load`].
+    pub fn load_frame(&self, count_frames: bool) -> anyhow::Result<Loaded> {
+        self.bond_settings()?;
         let t0 = Instant::now();
         let pb = spinner("loading");
         let (source, m, frames, warnings, format, file_bytes) = if let Some(scene) = self.scene {
@@ -176,19 +201,6 @@ impl InputArgs {
         for w in &warnings {
             pb.suspend(|| eprintln!("warning: {w}"));
         }
-        pb.set_message(format!("building bonds for {} atoms", m.len()));
-        let t1 = Instant::now();
-        let bonds = match self.bonds {
-            BondSource::Auto => try_build_bonds(&m, &bond_opts)?,
-            BondSource::File => match &m.file_bonds {
-                Some(b) => b.clone(),
-                None => {
-                    bail!("--bonds file: the input lists no bonds (LAMMPS data Bonds / PDB CONECT)")
-                }
-            },
-            BondSource::None => Vec::new(),
-        };
-        let bond_s = t1.elapsed().as_secs_f64();
         pb.finish_and_clear();
         Ok(Loaded {
             source,
@@ -197,9 +209,9 @@ impl InputArgs {
             warnings,
             format,
             file_bytes,
-            bonds,
+            bonds: Vec::new(),
             load_s,
-            bond_s,
+            bond_s: 0.0,
         })
     }
 }

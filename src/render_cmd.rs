@@ -9,14 +9,15 @@ use render::{
     accumulate, render_frame, Accum, Camera, FrameInputs, Framebuffer, Material, Modality,
     RenderSettings, SecondaryTraversal, TraceOptions, View,
 };
+use scene::{LightVolumeSettings, Orbit, Scene, SceneSettings, LIGHT_VOLUME_STRIDE};
 use spmd::Isa;
 use volume::{
-    ClassifiedTf, Light, LightVolume, Lighting, MarchOptions, Preset, TransferFunction,
-    VolumeScene, VolumeShadows,
+    Light, LightVolume, Lighting, MarchOptions, Preset, TransferFunction, VolumeScene,
+    VolumeShadows,
 };
 
 use crate::input::InputArgs;
-use crate::pipeline::{build_scene, build_volume, GeometryArgs, VolumeArgs};
+use crate::pipeline::{GeometryArgs, VolumeArgs};
 
 /// What a frame shows (the rows of the paper's Table 3).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -355,7 +356,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         Some(load_tf(&args.tf)?)
     };
 
-    let l = input.load(false)?;
+    let l = input.load_frame(false)?;
     let m = &l.molecule;
     if m.is_empty() {
         bail!("{}: no atoms to render", l.source);
@@ -376,17 +377,19 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         l.source,
         m.len()
     ));
-    verbose(format!(
-        "bonds:   {:.3} s  {} bonds",
-        l.bond_s,
-        l.bonds.len()
-    ));
-
-    let scene = if args.mode == Mode::Volume {
-        None
-    } else {
-        let (scene, secs) = build_scene(m, &l.bonds, &args.geometry)?;
-        let st = &scene.bvh.stats;
+    let settings = scene_settings(&args, &input, tf)?;
+    let pb = crate::input::spinner("building the scene");
+    let sc = Scene::build_with(isa, m, &settings, &|st| {
+        pb.set_message(format!("building the scene: {st:?}"))
+    })?;
+    pb.finish_and_clear();
+    if let Some(model) = &sc.model {
+        verbose(format!(
+            "bonds:   {:.3} s  {} bonds",
+            sc.timings.bonds,
+            sc.bonds.len()
+        ));
+        let st = &model.bvh.stats;
         verbose(format!(
             "bvh:     {:.3} s  {} prims, {} nodes, SAH {:.1}, {:.1} MB ({:.1} B/atom), scene build {:.3} s",
             st.build_time.as_secs_f64(),
@@ -395,64 +398,48 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             st.sah_cost,
             st.bytes as f64 / 1e6,
             st.bytes_per_atom(),
-            secs
+            sc.timings.model
         ));
-        Some(scene)
-    };
-    let vol = if matches!(args.mode, Mode::Bs | Mode::Path) {
-        None
-    } else {
-        let (vol, cells, secs) = build_volume(isa, m, &args.volume)?;
+    }
+    if let Some(d) = &sc.volume {
         verbose(format!(
             "volume:  {:.3} s  {:?} lattice points at {} /Å, {:.1} MB {}",
-            secs,
-            vol.grid.dims,
+            sc.timings.volume + sc.timings.macrocells,
+            d.volume.grid.dims,
             args.volume.voxels_per_angstrom,
-            vol.bytes() as f64 / 1e6,
-            vol.format().name()
+            d.volume.bytes() as f64 / 1e6,
+            d.volume.format().name()
         ));
-        Some((vol, cells))
-    };
+    }
+    if let Some(lv) = &sc.light_volume {
+        verbose(format!(
+            "light:   {:.3} s  light volume {:?} (every {} voxels), {:.1} MB",
+            sc.timings.light_volume,
+            lv.grid.dims,
+            lv.stride,
+            lv.bytes() as f64 / 1e6
+        ));
+    }
     // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
     // support, when there is no geometry).
-    let (center, radius) = match &scene {
-        Some(sc) => (sc.center, sc.radius),
-        None => crate::pipeline::bounding_sphere(m, 2.0),
-    };
     let camera = match &args.camera {
         Some(spec) => parse_camera(spec)?,
-        None => Camera::view(
+        None => Camera::fit(
             match args.view {
                 ViewArg::Far => View::Far,
                 ViewArg::Close => View::Close,
             },
-            center,
-            radius,
+            sc.sphere,
             args.fov,
             w as f32 / h as f32,
+            Orbit::default(),
         ),
     };
-    let classified = match (&tf, &vol) {
-        (Some(tf), Some((v, _))) => Some(ClassifiedTf::new(tf, 0.0, v.max_value, 0.5)),
-        _ => None,
-    };
-    let vscene = match (&vol, &classified) {
-        (Some((v, cells)), Some(ctf)) => {
-            Some(VolumeScene::new(v, cells, ctf, march_options(&args)))
-        }
-        _ => None,
-    };
-    let light_volume = match (&vscene, args.shadow_rays) {
-        (Some(vs), false) => build_light_volume(vs, isa, &verbose),
-        _ => None,
-    };
-    let vscene = match (vscene, &light_volume) {
-        (Some(vs), Some(lv)) => Some(vs.with_light_volume(lv)),
-        (vs, _) => vs,
-    };
+    let scene = sc.model.as_ref();
+    let vscene = sc.volume_scene(march_options(&args));
     let settings = render_settings(&args);
     let inputs = FrameInputs {
-        model: scene.as_ref(),
+        model: scene,
         volume: vscene.as_ref(),
         camera: &camera,
     };
@@ -514,8 +501,46 @@ fn volume_suffix(args: &RenderArgs) -> String {
     s
 }
 
-/// Stride (density voxels) of the light volume of volumetric shadows.
-pub(crate) const LIGHT_VOLUME_STRIDE: usize = 2;
+/// What `render` builds for the flags: the model unless `--mode volume`, the volume with
+/// `tf` (given for the volume modes) and its light volume for volumetric shadows unless
+/// `--shadow-rays`, the wide BVH when secondary or bounced rays use it.
+fn scene_settings(
+    args: &RenderArgs,
+    input: &InputArgs,
+    tf: Option<TransferFunction>,
+) -> Result<SceneSettings> {
+    let model = if args.mode == Mode::Volume {
+        None
+    } else {
+        let mut ms = args.geometry.settings()?;
+        ms.wide_bvh = modality(args).is_some()
+            && (args.secondary == SecondaryArg::Wide
+                || (args.mode == Mode::Path && args.bounce_traversal == SecondaryArg::Wide));
+        Some(ms)
+    };
+    let volume = match tf {
+        Some(tf) => {
+            let shadows = march_options(args).shadows.filter(|_| !args.shadow_rays);
+            Some(scene::VolumeSettings {
+                tf,
+                light_volume: shadows.map(|sh| LightVolumeSettings {
+                    light: sh.light,
+                    step_voxels: sh.step_voxels,
+                    stride: LIGHT_VOLUME_STRIDE,
+                }),
+                ..args.volume.settings()?
+            })
+        }
+        None => None,
+    };
+    Ok(SceneSettings {
+        model,
+        bonds: input.bond_settings()?,
+        volume,
+        budget_bytes: None,
+        frame: Some(args.size),
+    })
+}
 
 /// The light volume of `vs`'s volumetric shadows (`None` without them), timed.
 pub(crate) fn build_light_volume(

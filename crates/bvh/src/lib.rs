@@ -28,9 +28,9 @@ pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{
     end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,
 };
+pub use query::{Query, Stacks, Traversal};
 pub use traverse::{
     box_test, load_packet, slab_test, unpack_hits, Hit, PacketHit, Ray, RayPacket, BOX_GROW,
 };
-pub use query::{Query, Stacks, Traversal};
 pub use tree::{BuildStats, Builder, Bvh, Node, INNER, LEAF_MAX};
 pub use wide::{WideBvh, WideEntry, WideNode, WIDTH};

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use molecule::bonds::build_bonds;
+use molecule::bonds::try_build_bonds;
 use molecule::{elements, Molecule};
 use spmd::Isa;
 use volume::{
@@ -235,7 +235,7 @@ impl BondSettings {
 /// Replaces `out` with the bonds of `m`.
 fn fill_bonds(b: &BondSettings, m: &Molecule, out: &mut Vec<[u32; 2]>) -> Result<(), SceneError> {
     match b.source {
-        BondSource::Auto => *out = build_bonds(m, &b.options),
+        BondSource::Auto => *out = try_build_bonds(m, &b.options)?,
         BondSource::File => {
             let fb = m.file_bonds.as_ref().ok_or(SceneError::NoFileBonds)?;
             out.clear();

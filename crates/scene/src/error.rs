@@ -25,6 +25,9 @@ pub enum SceneError {
     /// [`crate::BondSource::File`] but the input lists no bonds.
     #[error("--bonds file: the input lists no bonds (LAMMPS data Bonds / PDB CONECT)")]
     NoFileBonds,
+    /// The bond search refused the atoms (extent or bond count; see [`molecule::bonds::BondError`]).
+    #[error(transparent)]
+    Bonds(#[from] molecule::bonds::BondError),
     /// No atoms.
     #[error("no atoms to build a scene of")]
     NoAtoms,

@@ -66,7 +66,7 @@ impl Default for ModelSettings {
 /// Where bonds come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BondSource {
-    /// Geometric rule (uniform-grid neighbour search, [`molecule::bonds::build_bonds`]).
+    /// Geometric rule (uniform-grid neighbour search, [`molecule::bonds::try_build_bonds`]).
     #[default]
     Auto,
     /// Bonds listed in the file (LAMMPS data `Bonds`, PDB `CONECT`); an error if there are none.

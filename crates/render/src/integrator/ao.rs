@@ -29,17 +29,7 @@ pub(super) fn sample<S: Simd>(
     let mut c = bg;
     if s.any(tr.mask) {
         let o = spawn(s, model, &tr);
-        let ao = ao_factor(
-            s,
-            q,
-            o,
-            tr.n,
-            tr.mask,
-            samples,
-            distance,
-            rng,
-            st,
-        );
+        let ao = ao_factor(s, q, o, tr.n, tr.mask, samples, distance, rng, st);
         c = V3::select(s, tr.mask, tr.color.scale(ao), bg);
     }
     over_rgb(s, tr.volume, c)

@@ -112,16 +112,9 @@ pub const RULES: &[Rule] = &[
         must_not: NO_OUT_OF_LINE_VOLUME,
     },
     Rule {
-        what: "render tile kernel",
+        what: "render tile (every integrator)",
         binary: Binary::Bnsview,
-        symbol: "spmd::x86::{isa}::entry::<render::tile::TileKernel",
-        must: &["{reg}"],
-        must_not: NO_OUT_OF_LINE_VOLUME,
-    },
-    Rule {
-        what: "render modal kernel",
-        binary: Binary::Bnsview,
-        symbol: "spmd::x86::{isa}::entry::<render::trace::ModalKernel",
+        symbol: "spmd::x86::{isa}::entry::<render::integrator::TileJob",
         must: &["{reg}"],
         must_not: NO_OUT_OF_LINE_VOLUME,
     },

@@ -204,6 +204,9 @@ fn render_rows_of(
     ))
 }
 
+/// Writes one tile's result into a destination row: `(tile, tile row, columns, row)`.
+type PutRow<'a, P> = dyn Fn(&TileOut, usize, usize, &mut [P]) + Sync + 'a;
+
 /// The tile scheduler: the tiles of `tiles` that meet rows `rows` of a `w × h` frame, each a
 /// rayon task dispatched once to `isa`, written into `buf` (those rows, `per_px` elements a
 /// pixel) by `put(tile, tile row, columns, destination row)`. Samples `first..first + spp`.
@@ -218,7 +221,7 @@ fn drive<P: Send>(
     per_px: usize,
     (first_sample, spp): (u32, u32),
     isa: Isa,
-    put: &(dyn Fn(&TileOut, usize, usize, &mut [P]) + Sync),
+    put: &PutRow<'_, P>,
 ) -> RenderStats {
     let start = Instant::now();
     let view = ViewRays::new(inp.camera, w, h);

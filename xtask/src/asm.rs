@@ -112,9 +112,9 @@ pub const RULES: &[Rule] = &[
         must_not: NO_OUT_OF_LINE_VOLUME,
     },
     Rule {
-        what: "render tile (every integrator)",
+        what: "render tiles (headlight, sampled)",
         binary: Binary::Bnsview,
-        symbol: "spmd::x86::{isa}::entry::<render::integrator::TileJob",
+        symbol: "spmd::x86::{isa}::entry::<render::integrator::",
         must: &["{reg}"],
         must_not: NO_OUT_OF_LINE_VOLUME,
     },

@@ -264,7 +264,7 @@ fn drive<P: Send>(
                         first_sample,
                         spp,
                     };
-                    (tx, isa.dispatch(job))
+                    (tx, job.dispatch(isa))
                 })
                 .collect();
             for (tx, out) in &outs {

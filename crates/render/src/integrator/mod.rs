@@ -49,14 +49,37 @@ pub(crate) struct TileJob<'a> {
     pub(crate) spp: u32,
 }
 
-impl Kernel for TileJob<'_> {
-    type Output = TileOut;
-    #[inline(always)]
-    fn run<S: Simd>(self, s: S) -> TileOut {
+impl TileJob<'_> {
+    /// Runs the tile on `isa`: the headlight modes and the sampled modalities are two
+    /// kernels, so each `#[target_feature]` entry point holds one of them (as at a81d852;
+    /// one entry holding every integrator is one very large function for LLVM).
+    pub(crate) fn dispatch(self, isa: spmd::Isa) -> TileOut {
         match self.set.modality {
-            Modality::Headlight => TileOut::Packed(headlight::tile(s, &self)),
-            _ => TileOut::Rgb(sampled::tile(s, &self)),
+            Modality::Headlight => TileOut::Packed(isa.dispatch(HeadlightTile(self))),
+            _ => TileOut::Rgb(isa.dispatch(SampledTile(self))),
         }
+    }
+}
+
+/// The headlight b&s / volume / vol+bs tile kernel (paper §4.2 `renderTile`).
+struct HeadlightTile<'a>(TileJob<'a>);
+
+impl Kernel for HeadlightTile<'_> {
+    type Output = Vec<u32>;
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) -> Vec<u32> {
+        headlight::tile(s, &self.0)
+    }
+}
+
+/// The sampled modalities' tile kernel: direct light, AO, path (paper §4.5).
+struct SampledTile<'a>(TileJob<'a>);
+
+impl Kernel for SampledTile<'_> {
+    type Output = Vec<f32>;
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) -> Vec<f32> {
+        sampled::tile(s, &self.0)
     }
 }
 

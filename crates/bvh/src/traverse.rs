@@ -197,38 +197,29 @@ impl Bvh {
                             if N > 1 && s.none(masks[j]) {
                                 continue;
                             }
+                            // One leaf test; any-hit starts from "no hit" and its epilog
+                            // ends a hit lane (t = −∞ fails every box), closest keeps the nearest.
+                            let mut tt = hits[j].t;
+                            let mut slot = if ANY { s.splat_i(-1) } else { hits[j].slot };
+                            intersect_record(
+                                s,
+                                rays[j].o,
+                                rays[j].d,
+                                rec,
+                                capped,
+                                rays[j].tmin,
+                                &mut tt,
+                                &mut slot,
+                                (first + k) as i32,
+                                masks[j],
+                            );
                             if ANY {
-                                // Any-hit epilog: a hit lane is done (t = −∞ fails every box).
-                                let mut tt = hits[j].t;
-                                let mut slot = s.splat_i(-1);
-                                intersect_record(
-                                    s,
-                                    rays[j].o,
-                                    rays[j].d,
-                                    rec,
-                                    capped,
-                                    rays[j].tmin,
-                                    &mut tt,
-                                    &mut slot,
-                                    (first + k) as i32,
-                                    masks[j],
-                                );
                                 let hit = s.gt_i(slot, s.splat_i(-1));
                                 hits[j].slot = s.select_i(hit, slot, hits[j].slot);
                                 hits[j].t = s.select(hit, s.splat(f32::NEG_INFINITY), hits[j].t);
                             } else {
-                                intersect_record(
-                                    s,
-                                    rays[j].o,
-                                    rays[j].d,
-                                    rec,
-                                    capped,
-                                    rays[j].tmin,
-                                    &mut hits[j].t,
-                                    &mut hits[j].slot,
-                                    (first + k) as i32,
-                                    masks[j],
-                                );
+                                hits[j].t = tt;
+                                hits[j].slot = slot;
                             }
                         }
                     }

@@ -1,5 +1,6 @@
 //! `bnsview bench`: its flags, turned into the [`bnsbench::Config`] of a run (the benchmark
-//! itself is the `bnsbench` crate; [`crate::bench_pipeline`] renders its frames as `render`).
+//! itself is the `bnsbench` crate, which renders each mode as `render` renders it: the
+//! tests below check that flag for flag).
 
 use std::path::PathBuf;
 
@@ -10,7 +11,6 @@ use spmd::Isa;
 
 use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel};
 
-use crate::bench_pipeline::CliPipeline;
 use crate::pipeline::GeometryArgs;
 use crate::render_cmd::{parse_size, ViewArg};
 
@@ -102,8 +102,8 @@ fn parse_side(s: &str) -> Result<(u32, u32), String> {
 
 impl BenchArgs {
     /// The run these flags ask for.
-    pub fn config(&self) -> Config {
-        Config {
+    pub fn config(&self) -> Result<Config> {
+        Ok(Config {
             spec: PlanSpec {
                 table: self.table,
                 scenes: self.scenes.clone(),
@@ -118,6 +118,9 @@ impl BenchArgs {
                 quick: self.quick,
                 atoms: self.atoms,
             },
+            seed: self.seed,
+            model: self.geometry.settings()?,
+            tf: volume::TransferFunction::from_spec(&self.tf)?,
             frames: self.frames,
             warmup: self.warmup,
             voxels_per_angstrom: self.voxels_per_angstrom,
@@ -126,7 +129,7 @@ impl BenchArgs {
             force: self.force,
             command: std::env::args().collect::<Vec<_>>().join(" "),
             version: env!("CARGO_PKG_VERSION").into(),
-        }
+        })
     }
 }
 
@@ -135,12 +138,13 @@ pub fn run(a: BenchArgs, isas: Vec<Isa>) -> Result<()> {
     if !a.report.is_empty() {
         return Ok(bnsbench::run_report(&a.report)?);
     }
-    Ok(bnsbench::run(&a.config(), &isas, &CliPipeline::new(&a))?)
+    Ok(bnsbench::run(&a.config()?, &isas)?)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render_cmd::Mode;
     use bnsbench::{plan, BenchMode};
 
     fn args(extra: &[&str]) -> BenchArgs {
@@ -160,6 +164,7 @@ mod tests {
         let p = plan(
             &args(&["--scenes", "nanobowl", "--size", "64x64"])
                 .config()
+                .unwrap()
                 .spec,
             2,
         );
@@ -167,11 +172,14 @@ mod tests {
         let c = args(&[
             "--scenes", "nanobowl", "--table", "1", "--sizes", "32,64x48",
         ])
-        .config();
+        .config()
+        .unwrap();
         let p = plan(&c.spec, 2);
         assert_eq!(p.len(), 2);
         assert_eq!((p[1].0.w, p[1].0.h), (64, 48));
-        let c = args(&["--views", "close", "--threads", "3", "--quick"]).config();
+        let c = args(&["--views", "close", "--threads", "3", "--quick"])
+            .config()
+            .unwrap();
         assert_eq!(c.spec.views, Some(vec![false]));
         assert_eq!(c.spec.threads, Some(vec![3]));
         assert!(c.spec.quick);
@@ -179,33 +187,56 @@ mod tests {
     }
 
     #[test]
-    fn mode_sets_expand_in_order_each_once() {
-        let modes = |a: &[&str]| {
-            let mut v = vec!["--modes"];
-            v.extend_from_slice(a);
-            args(&v).config().spec.modes.unwrap()
-        };
-        assert_eq!(modes(&["modalities"]), BenchMode::MODALITIES);
-        assert_eq!(modes(&["all"]), BenchMode::ALL);
-        let m: Vec<&str> = modes(&["path,modalities,bs"])
-            .iter()
-            .map(|m| m.name())
-            .collect();
-        assert_eq!(
-            m,
-            [
-                "path",
-                "bs-shadows",
-                "bs-ao",
-                "volume-lit",
-                "vol+bs-lit",
-                "volume-shadows",
-                "volume-lit-shadows",
-                "bs"
-            ]
-        );
+    fn mode_flags_name_the_modes_and_sets() {
+        // The order of a set's expansion is bnsbench's (mode.rs tests it); here the flags.
+        let modes = |a: &str| args(&["--modes", a]).config().unwrap().spec.modes.unwrap();
+        assert_eq!(modes("modalities"), BenchMode::MODALITIES);
+        assert_eq!(modes("all"), BenchMode::ALL);
         for mode in BenchMode::ALL {
-            assert_eq!(modes(&[mode.name()]), [mode]);
+            assert_eq!(modes(mode.name()), [mode]);
+        }
+    }
+
+    /// The `bnsview render` flags of each bench mode's picture, one sample per pixel.
+    fn render_flags(mode: BenchMode) -> &'static [&'static str] {
+        match mode {
+            BenchMode::Bs => &[],
+            BenchMode::Volume => &["--mode", "volume"],
+            BenchMode::VolBs => &["--mode", "vol+bs"],
+            BenchMode::VolBsLit => &["--mode", "vol+bs", "--lit"],
+            BenchMode::VolumeLit => &["--mode", "volume", "--lit"],
+            BenchMode::BsShadows => &["--shadows"],
+            BenchMode::BsAo => &["--ao", "1"],
+            BenchMode::Path => &["--mode", "path", "--material", "metal", "--spp", "1"],
+            BenchMode::VolBsShadows => &["--mode", "vol+bs", "--shadows", "--volume-shadows"],
+            BenchMode::VolumeShadows => &["--mode", "volume", "--volume-shadows"],
+            BenchMode::VolumeLitShadows => &["--mode", "volume", "--lit", "--volume-shadows"],
+        }
+    }
+
+    #[test]
+    fn every_bench_mode_renders_what_its_render_flags_render() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct R {
+            #[command(flatten)]
+            r: crate::render_cmd::RenderArgs,
+        }
+        for m in BenchMode::ALL {
+            let argv = std::iter::once("render").chain(render_flags(m).iter().copied());
+            let a = R::parse_from(argv).r;
+            crate::render_cmd::check_modalities(&a).unwrap();
+            assert_eq!(
+                crate::render_cmd::render_settings(&a),
+                m.settings(),
+                "{m:?}"
+            );
+            assert_eq!(a.mode != Mode::Volume, m.geometry(), "{m:?}");
+            assert_eq!(
+                matches!(a.mode, Mode::Volume | Mode::VolBs),
+                m.volume(),
+                "{m:?}"
+            );
         }
     }
 

@@ -11,17 +11,7 @@ use molecule::bonds::BondOptions;
 use molecule::read::{open, Format, FrameIndex, ReadOptions};
 use molecule::scenes::{try_generate, SceneName};
 use molecule::Molecule;
-
-/// Where bonds come from.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BondSource {
-    /// Geometric rule (uniform-grid neighbour search).
-    Auto,
-    /// Bonds listed in the file (LAMMPS data `Bonds`, PDB `CONECT`); error if there are none.
-    File,
-    /// No bonds.
-    None,
-}
+use scene::BondSource;
 
 /// Where the atoms come from and how they are bonded.
 #[derive(Args, Debug, Clone)]
@@ -105,11 +95,7 @@ impl InputArgs {
     /// Bond settings from the flags.
     pub fn bond_settings(&self) -> anyhow::Result<scene::BondSettings> {
         Ok(scene::BondSettings {
-            source: match self.bonds {
-                BondSource::Auto => scene::BondSource::Auto,
-                BondSource::File => scene::BondSource::File,
-                BondSource::None => scene::BondSource::None,
-            },
+            source: self.bonds,
             options: self.bond_options()?,
         })
     }

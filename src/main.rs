@@ -5,7 +5,6 @@ use clap::{Parser, Subcommand};
 use spmd::Isa;
 
 mod bench_cmd;
-mod bench_pipeline;
 mod generate;
 mod info;
 mod input;

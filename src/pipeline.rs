@@ -1,41 +1,17 @@
 //! The clap flags of the scene (geometry, volume) and their mapping onto the typed
 //! [`scene::SceneSettings`]; the building itself is `scene::Scene::build`.
 
-use std::time::Instant;
-
-use clap::{Args, ValueEnum};
-use molecule::Molecule;
-use render::{Colormap, Model, Style};
-use scene::{ColorBy, ModelSettings, VolumeSettings};
-use spmd::Isa;
-use volume::{Macrocells, Volume, VolumeFormat};
-
-/// Which radius of the element table sizes the balls.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RadiusKind {
-    /// Covalent radius (Cordero 2008), scaled by `--radius-scale`.
-    Covalent,
-    /// Van der Waals radius (Alvarez 2013), scaled by `--radius-scale`.
-    Vdw,
-}
-
-/// Drawing style (`--style`).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StyleArg {
-    /// Balls and sticks.
-    BallAndStick,
-    /// Sticks only, with round caps.
-    Licorice,
-    /// Balls only (space-filling; use with `--radius vdw --radius-scale 1`).
-    Spheres,
-}
+use clap::Args;
+use render::{Colormap, Style};
+use scene::{ColorBy, ModelSettings, RadiusKind, VolumeSettings};
+use volume::VolumeFormat;
 
 /// Geometry options of the ball-and-stick scene.
 #[derive(Args, Debug, Clone)]
 pub struct GeometryArgs {
     /// Drawing style.
-    #[arg(long, value_enum, default_value_t = StyleArg::BallAndStick)]
-    pub style: StyleArg,
+    #[arg(long, value_enum, default_value_t = Style::BallAndStick)]
+    pub style: Style,
     /// Radius used for the balls.
     #[arg(long, value_enum, default_value_t = RadiusKind::Covalent)]
     pub radius: RadiusKind,
@@ -49,9 +25,9 @@ pub struct GeometryArgs {
     /// (e.g. `q`, `type`, `id`) through `--colormap`.
     #[arg(long, default_value = "element")]
     pub color: String,
-    /// Colormap for `--color COLUMN`: viridis or gray.
-    #[arg(long, default_value = "viridis")]
-    pub colormap: String,
+    /// Colormap for `--color COLUMN`.
+    #[arg(long, value_enum, default_value_t = Colormap::Viridis)]
+    pub colormap: Colormap,
 }
 
 /// Volume options (the density grid).
@@ -73,23 +49,12 @@ impl GeometryArgs {
         } else {
             ColorBy::Column {
                 name: self.color.clone(),
-                colormap: match self.colormap.as_str() {
-                    "viridis" => Colormap::Viridis,
-                    "gray" | "grey" => Colormap::Gray,
-                    other => anyhow::bail!("--colormap {other}: expected viridis or gray"),
-                },
+                colormap: self.colormap,
             }
         };
         Ok(ModelSettings {
-            style: match self.style {
-                StyleArg::BallAndStick => Style::BallAndStick,
-                StyleArg::Licorice => Style::Licorice,
-                StyleArg::Spheres => Style::Spheres,
-            },
-            radius: match self.radius {
-                RadiusKind::Covalent => scene::RadiusKind::Covalent,
-                RadiusKind::Vdw => scene::RadiusKind::Vdw,
-            },
+            style: self.style,
+            radius: self.radius,
             radius_scale: self.radius_scale,
             stick_radius: self.stick_radius,
             color,
@@ -111,26 +76,4 @@ impl VolumeArgs {
             ..VolumeSettings::default()
         })
     }
-}
-
-/// The ball-and-stick scene of a molecule and its build time (s) (for `bench`).
-pub fn build_scene(
-    m: &Molecule,
-    bonds: &[[u32; 2]],
-    g: &GeometryArgs,
-) -> anyhow::Result<(Model, f64)> {
-    let t = Instant::now();
-    let model = g.settings()?.build_model(m, bonds)?;
-    Ok((model, t.elapsed().as_secs_f64()))
-}
-
-/// The density volume of a molecule with its macrocells, and the build time (s) (for `bench`).
-pub fn build_volume(
-    isa: Isa,
-    m: &Molecule,
-    v: &VolumeArgs,
-) -> anyhow::Result<(Volume, Macrocells, f64)> {
-    let t = Instant::now();
-    let (vol, cells) = v.settings()?.build_density(isa, m)?;
-    Ok((vol, cells, t.elapsed().as_secs_f64()))
 }

@@ -1,20 +1,16 @@
 //! `bnsview render`: a molecule file or a built-in scene to a PNG.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use render::{
-    accumulate, render_frame, Accum, Camera, FrameInputs, Framebuffer, Material, Modality,
-    RenderSettings, SecondaryTraversal, TraceOptions, View,
+    render_frame, Camera, FrameInputs, Framebuffer, Material, Modality, RenderSettings,
+    SecondaryTraversal, View, DARK_BACKGROUND, HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
 };
 use scene::{LightVolumeSettings, Orbit, Scene, SceneSettings, LIGHT_VOLUME_STRIDE};
 use spmd::Isa;
-use volume::{
-    Light, LightVolume, Lighting, MarchOptions, Preset, TransferFunction, VolumeScene,
-    VolumeShadows,
-};
+use volume::{Light, Lighting, MarchOptions, TransferFunction, VolumeShadows};
 
 use crate::input::InputArgs;
 use crate::pipeline::{GeometryArgs, VolumeArgs};
@@ -45,57 +41,45 @@ impl Mode {
     }
 }
 
-/// BRDF of the path tracer (`--material`).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MaterialArg {
-    /// Conductor with Schlick Fresnel (F0 = atom colour), blurred by --roughness.
-    Metal,
-    /// Lambertian.
-    Diffuse,
-}
-
-/// Traversal of secondary rays (`--secondary`, `--bounce-traversal`).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SecondaryArg {
-    /// A pixel block's secondary rays as one packet over the binary BVH.
-    Packet,
-    /// One ray at a time through the binary BVH (scalar traversal).
-    Single,
-    /// One ray at a time through the 8-wide BVH (eight child boxes per SIMD op).
-    Wide,
-}
-
-impl From<SecondaryArg> for SecondaryTraversal {
-    fn from(a: SecondaryArg) -> Self {
-        match a {
-            SecondaryArg::Packet => SecondaryTraversal::Packet,
-            SecondaryArg::Single => SecondaryTraversal::Single,
-            SecondaryArg::Wide => SecondaryTraversal::Wide,
-        }
-    }
-}
-
-fn parse_dir(s: &str) -> Result<[f32; 3], String> {
+/// Three finite numbers `x,y,z`.
+fn vec3(s: &str) -> Option<[f32; 3]> {
     let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
     match v.as_slice() {
-        [Some(x), Some(y), Some(z)]
-            if [x, y, z].iter().all(|a| a.is_finite()) && (x * x + y * y + z * z) > 0.0 =>
-        {
-            Ok([*x, *y, *z])
+        [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|a| a.is_finite()) => {
+            Some([*x, *y, *z])
         }
-        _ => Err(format!("{s:?}: expected a non-zero direction x,y,z")),
+        _ => None,
     }
+}
+
+/// Parses a direction `x,y,z` (not zero).
+fn parse_dir(s: &str) -> Result<[f32; 3], String> {
+    vec3(s)
+        .filter(|v| v.iter().any(|c| *c != 0.0))
+        .ok_or_else(|| format!("{s:?}: expected a non-zero direction x,y,z"))
+}
+
+/// Parses a positive finite number.
+fn positive(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .ok_or_else(|| format!("{s:?}: expected a positive number"))
+}
+
+/// Parses a finite number ≥ 0.
+fn non_negative(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| *v >= 0.0 && v.is_finite())
+        .ok_or_else(|| format!("{s:?}: expected a number ≥ 0"))
 }
 
 /// Parses a point `x,y,z` (Å).
 fn parse_point(s: &str) -> Result<[f32; 3], String> {
-    let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
-    match v.as_slice() {
-        [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
-        _ => Err(format!(
-            "{s:?}: expected a point x,y,z in Å (three finite numbers)"
-        )),
-    }
+    vec3(s).ok_or_else(|| format!("{s:?}: expected a point x,y,z in Å (three finite numbers)"))
 }
 
 /// Which of the paper's views (Table 3).
@@ -150,13 +134,13 @@ pub struct RenderArgs {
     pub lit: bool,
     /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir or --light-pos with hard
     /// shadows.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "ao")]
     pub shadows: bool,
     /// Ball-and-stick (bs, vol+bs): ambient occlusion with N cosine-distributed rays per hit.
     #[arg(long, value_name = "N")]
     pub ao: Option<u32>,
     /// Ambient occlusion distance (Å).
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, default_value_t = 4.0, value_parser = positive)]
     pub ao_distance: f32,
     /// Direction towards a directional light, world space `x,y,z` (default 1,2,1.5).
     #[arg(long, value_parser = parse_dir, conflicts_with = "light_pos", allow_hyphen_values = true)]
@@ -183,16 +167,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub shadow_rays: bool,
     /// Path tracing: BRDF of the atoms.
-    #[arg(long, value_enum, default_value_t = MaterialArg::Metal)]
-    pub material: MaterialArg,
+    #[arg(long, value_enum, default_value_t = Material::Metal)]
+    pub material: Material,
     /// Path tracing: samples per pixel.
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
     /// Path tracing: maximum hits per path.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..))]
     pub max_depth: u32,
     /// Path tracing, metal: roughness (0 = mirror).
-    #[arg(long, default_value_t = 0.15)]
+    #[arg(long, default_value_t = 0.15, value_parser = non_negative)]
     pub roughness: f32,
     /// Path tracing: exposure (radiance multiplier before clamp and gamma 2).
     #[arg(long, default_value_t = 1.0)]
@@ -202,11 +186,11 @@ pub struct RenderArgs {
     pub sample_seed: u32,
     /// Traversal of shadow and AO rays (and the path tracer's light samples): packets with
     /// any-hit exit, single rays, or single rays over the 8-wide BVH.
-    #[arg(long, value_enum, default_value_t = SecondaryArg::Packet)]
-    pub secondary: SecondaryArg,
+    #[arg(long, value_enum, default_value_t = SecondaryTraversal::Packet)]
+    pub secondary: SecondaryTraversal,
     /// Traversal of the path tracer's bounced rays (camera rays always go in packets).
-    #[arg(long, value_enum, default_value_t = SecondaryArg::Wide)]
-    pub bounce_traversal: SecondaryArg,
+    #[arg(long, value_enum, default_value_t = SecondaryTraversal::Wide)]
+    pub bounce_traversal: SecondaryTraversal,
     /// Volume: march every cell (no macrocell skipping), for comparison.
     #[arg(long)]
     pub no_macrocells: bool,
@@ -239,75 +223,6 @@ fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
         [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b]),
         _ => Err(format!("{s:?}: expected r,g,b with each 0-255")),
     }
-}
-
-fn parse_vec3(key: &str, v: &str) -> Result<[f32; 3]> {
-    let c: Vec<f32> = v
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--camera {key}={v}: expected three numbers x,y,z"))?;
-    match c.as_slice() {
-        [x, y, z] if c.iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
-        _ => bail!("--camera {key}={v}: expected three finite numbers x,y,z"),
-    }
-}
-
-/// Parses `--camera eye=..:at=..[:up=..][:fov=..][:ortho=..]`.
-pub fn parse_camera(spec: &str) -> Result<Camera> {
-    let (mut eye, mut at, mut up, mut fov, mut ortho) =
-        (None, None, [0.0, 1.0, 0.0], 45.0f32, None);
-    for part in spec.split(':').filter(|p| !p.trim().is_empty()) {
-        let (k, v) = part
-            .split_once('=')
-            .with_context(|| format!("--camera: {part:?} is not key=value"))?;
-        match k.trim() {
-            "eye" => eye = Some(parse_vec3(k, v)?),
-            "at" => at = Some(parse_vec3(k, v)?),
-            "up" => up = parse_vec3(k, v)?,
-            "fov" => {
-                fov = v
-                    .trim()
-                    .parse()
-                    .ok()
-                    .filter(|f: &f32| *f > 0.0 && *f < 180.0)
-                    .with_context(|| format!("--camera fov={v}: expected degrees in (0, 180)"))?
-            }
-            "ortho" => {
-                ortho = Some(
-                    v.trim()
-                        .parse::<f32>()
-                        .ok()
-                        .filter(|h| *h > 0.0)
-                        .with_context(|| {
-                            format!("--camera ortho={v}: expected a positive height in Å")
-                        })?,
-                )
-            }
-            other => bail!("--camera: unknown key {other:?} (expected eye, at, up, fov, ortho)"),
-        }
-    }
-    let eye = eye.context("--camera needs eye=x,y,z")?;
-    let at = at.context("--camera needs at=x,y,z")?;
-    if eye == at {
-        bail!("--camera: eye and at are the same point");
-    }
-    Ok(match ortho {
-        Some(h) => Camera::orthographic(eye, at, up, h),
-        None => Camera::look_at(eye, at, up, fov),
-    })
-}
-
-/// Loads a transfer function: a preset name or a control-point file.
-pub fn load_tf(spec: &str) -> Result<TransferFunction> {
-    if let Ok(p) = spec.parse::<Preset>() {
-        return Ok(TransferFunction::preset(p));
-    }
-    let path = std::path::Path::new(spec);
-    if path.exists() {
-        return TransferFunction::load(path).map_err(Into::into);
-    }
-    bail!("--tf {spec:?}: neither a preset (coolwarm, viridis, grayscale) nor an existing file")
 }
 
 /// Run `bnsview render`.
@@ -353,7 +268,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     let tf = if matches!(args.mode, Mode::Bs | Mode::Path) {
         None
     } else {
-        Some(load_tf(&args.tf)?)
+        Some(TransferFunction::from_spec(&args.tf)?)
     };
 
     let l = input.load_frame(false)?;
@@ -383,47 +298,11 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         pb.set_message(format!("building the scene: {st:?}"))
     })?;
     pb.finish_and_clear();
-    if let Some(model) = &sc.model {
-        verbose(format!(
-            "bonds:   {:.3} s  {} bonds",
-            sc.timings.bonds,
-            sc.bonds.len()
-        ));
-        let st = &model.bvh.stats;
-        verbose(format!(
-            "bvh:     {:.3} s  {} prims, {} nodes, SAH {:.1}, {:.1} MB ({:.1} B/atom), scene build {:.3} s",
-            st.build_time.as_secs_f64(),
-            st.prims,
-            st.nodes,
-            st.sah_cost,
-            st.bytes as f64 / 1e6,
-            st.bytes_per_atom(),
-            sc.timings.model
-        ));
-    }
-    if let Some(d) = &sc.volume {
-        verbose(format!(
-            "volume:  {:.3} s  {:?} lattice points at {} /Å, {:.1} MB {}",
-            sc.timings.volume + sc.timings.macrocells,
-            d.volume.grid.dims,
-            args.volume.voxels_per_angstrom,
-            d.volume.bytes() as f64 / 1e6,
-            d.volume.format().name()
-        ));
-    }
-    if let Some(lv) = &sc.light_volume {
-        verbose(format!(
-            "light:   {:.3} s  light volume {:?} (every {} voxels), {:.1} MB",
-            sc.timings.light_volume,
-            lv.grid.dims,
-            lv.stride,
-            lv.bytes() as f64 / 1e6
-        ));
-    }
+    sc.stage_report().into_iter().for_each(verbose);
     // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
     // support, when there is no geometry).
     let camera = match &args.camera {
-        Some(spec) => parse_camera(spec)?,
+        Some(spec) => spec.parse::<Camera>()?,
         None => Camera::fit(
             match args.view {
                 ViewArg::Far => View::Far,
@@ -443,40 +322,22 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         volume: vscene.as_ref(),
         camera: &camera,
     };
-    let t = Instant::now();
-    let fb = if settings.modality == Modality::Headlight {
-        let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
-        let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
-        verbose(format!(
-            "render:  {:.3} s  {}x{} {}{} ({:.1} Mrays/s, {:.2} fps)",
-            t.elapsed().as_secs_f64(),
-            w,
-            h,
-            args.mode.name(),
-            volume_suffix(&args),
-            stats.mrays_per_s(),
-            stats.fps()
-        ));
-        fb
-    } else {
-        let path = args.mode == Mode::Path;
-        let spp = samples_per_pixel(&args);
-        let mut acc = Accum::new(w, h)?;
-        let stats = accumulate(&inputs, &settings, &mut acc, spp, isa)?;
-        let secs = stats.time.as_secs_f64();
-        verbose(format!(
-            "render:  {secs:.3} s  {w}x{h} {}{} ({:.2} fps{})",
-            args.mode.name(),
-            modality_name(&args),
-            1.0 / secs.max(1e-12),
-            if path {
-                format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
-            } else {
-                String::new()
-            }
-        ));
-        acc.to_framebuffer(path, args.exposure)
-    };
+    let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
+    let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
+    let (secs, spp) = (stats.time.as_secs_f64(), settings.frame_samples());
+    verbose(format!(
+        "render:  {secs:.3} s  {w}x{h} {}{}{} ({:.1} Mrays/s, {:.2} fps{})",
+        args.mode.name(),
+        modality_name(&args),
+        volume_suffix(&args),
+        stats.mrays_per_s(),
+        stats.fps(),
+        if settings.is_linear() {
+            format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
+        } else {
+            String::new()
+        }
+    ));
     fb.save_png(&output)
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
@@ -513,9 +374,9 @@ fn scene_settings(
         None
     } else {
         let mut ms = args.geometry.settings()?;
-        ms.wide_bvh = modality(args).is_some()
-            && (args.secondary == SecondaryArg::Wide
-                || (args.mode == Mode::Path && args.bounce_traversal == SecondaryArg::Wide));
+        ms.wide_bvh = modality(args) != Modality::Headlight
+            && (args.secondary == SecondaryTraversal::Wide
+                || (args.mode == Mode::Path && args.bounce_traversal == SecondaryTraversal::Wide));
         Some(ms)
     };
     let volume = match tf {
@@ -542,57 +403,13 @@ fn scene_settings(
     })
 }
 
-/// The light volume of `vs`'s volumetric shadows (`None` without them), timed.
-pub(crate) fn build_light_volume(
-    vs: &VolumeScene,
-    isa: Isa,
-    verbose: &dyn Fn(String),
-) -> Option<LightVolume> {
-    let sh = vs.opts.shadows?;
-    let t = Instant::now();
-    let lv = LightVolume::build(isa, vs, sh, LIGHT_VOLUME_STRIDE);
-    verbose(format!(
-        "light:   {:.3} s  light volume {:?} (every {} voxels), {:.1} MB",
-        t.elapsed().as_secs_f64(),
-        lv.grid.dims,
-        LIGHT_VOLUME_STRIDE,
-        lv.bytes() as f64 / 1e6
-    ));
-    Some(lv)
-}
-
-/// The `RenderArgs` of `bnsview render FLAGS` (clap's defaults for every flag not given), so
-/// that other commands (`bnsview bench`) render exactly what `render` would.
-pub(crate) fn parse_render_flags(flags: &[&str]) -> Result<RenderArgs> {
-    use clap::Parser;
-    #[derive(Parser)]
-    struct Render {
-        #[command(flatten)]
-        args: RenderArgs,
-    }
-    let argv = std::iter::once("render").chain(flags.iter().copied());
-    Render::try_parse_from(argv)
-        .map(|r| r.args)
-        .with_context(|| format!("parsing the render flags {}", flags.join(" ")))
-}
-
 /// Background colour: `--background`, else white for `bs` and near-black for the others.
 fn background(args: &RenderArgs) -> [u8; 3] {
     args.background.unwrap_or(if args.mode == Mode::Bs {
-        [255, 255, 255]
+        WHITE_BACKGROUND
     } else {
-        [12, 12, 20]
+        DARK_BACKGROUND
     })
-}
-
-/// Samples per pixel of a modality render: `--spp` for path tracing, else 1 (Direct and AO
-/// trace the pixel centre, so more samples would only repeat it).
-pub(crate) fn samples_per_pixel(args: &RenderArgs) -> u32 {
-    if args.mode == Mode::Path {
-        args.spp
-    } else {
-        1
-    }
 }
 
 /// The light of the flags: `--light-pos`, else `--light-dir`, else the default direction.
@@ -626,111 +443,77 @@ pub(crate) fn march_options(args: &RenderArgs) -> MarchOptions {
     }
 }
 
-/// Options of the ray tracing modalities from the flags.
-pub(crate) fn trace_options(args: &RenderArgs, modality: Modality) -> TraceOptions {
-    let [r, g, b] = background(args);
-    TraceOptions {
+/// Every render option of the flags as one [`RenderSettings`] (headlight modes: ambient
+/// [`render::HEADLIGHT_AMBIENT`]; `--ambient` is the ambient term of the traced modalities).
+pub(crate) fn render_settings(args: &RenderArgs) -> RenderSettings {
+    let modality = modality(args);
+    RenderSettings {
         modality,
+        march: march_options(args),
         light: light(args),
         light_intensity: args.light_intensity,
-        ambient: args.ambient,
-        background: [r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0],
+        ambient: if modality == Modality::Headlight {
+            HEADLIGHT_AMBIENT
+        } else {
+            args.ambient
+        },
+        background: background(args),
+        exposure: args.exposure,
         seed: args.sample_seed,
+        spp: if args.mode == Mode::Path { args.spp } else { 1 },
         volume_shadows: args.volume_shadows,
         shadow_step_voxels: args.shadow_step,
-        exposure: args.exposure,
-        secondary: args.secondary.into(),
-        bounces: args.bounce_traversal.into(),
-    }
-}
-
-/// Every render option of the flags as one [`RenderSettings`] (headlight modes: ambient
-/// [`render::HEADLIGHT_AMBIENT`]; `--ambient` is the ambient term of `--shadows`).
-pub(crate) fn render_settings(args: &RenderArgs) -> RenderSettings {
-    let background = background(args);
-    match modality(args) {
-        None => RenderSettings {
-            march: march_options(args),
-            ..RenderSettings::headlight(background)
-        },
-        Some(modality) => RenderSettings {
-            march: march_options(args),
-            spp: args.spp,
-            background,
-            ..trace_options(args, modality).settings(args.spp)
-        },
+        secondary: args.secondary,
+        bounces: args.bounce_traversal,
+        packet_registers: 0,
     }
 }
 
 /// Rejects combinations of modality flags that do nothing, with what to use instead: the
 /// flag conflicts here, every rule on the resulting settings in [`RenderSettings::validate`].
 pub(crate) fn check_modalities(args: &RenderArgs) -> Result<()> {
-    let m = args.mode;
-    if args.lit && matches!(m, Mode::Bs | Mode::Path) {
-        bail!("--lit lights the volume: use it with --mode volume or --mode vol+bs");
+    if (args.shadows || args.ao.is_some()) && args.mode == Mode::Path {
+        // The path tracer has its own lighting: these flags would be ignored.
+        return Err(render::SettingsError::NeedsModel.into());
     }
-    if args.shadows && args.ao.is_some() {
-        bail!("--shadows and --ao are separate modalities: choose one");
-    }
-    if (args.shadows || args.ao.is_some()) && matches!(m, Mode::Volume | Mode::Path) {
-        bail!(
-            "--shadows and --ao shade ball-and-stick hits: use them with --mode bs or vol+bs \
-             (--mode path has its own lighting; for volumetric shadows use --mode volume \
-             --volume-shadows)"
-        );
-    }
-    // Values of flags the chosen modality does not use are still checked.
-    if !(args.ao_distance > 0.0 && args.ao_distance.is_finite()) {
-        bail!("--ao-distance must be a positive number of Å");
-    }
-    if args.max_depth == 0 {
-        bail!("--max-depth must be at least 1");
-    }
-    if !(args.roughness >= 0.0 && args.roughness.is_finite()) {
-        bail!("--roughness must be a non-negative number");
-    }
-    let has_model = m != Mode::Volume;
-    let has_volume = matches!(m, Mode::Volume | Mode::VolBs);
-    render_settings(args).validate(has_model, has_volume)?;
-    Ok(())
+    let has_model = args.mode != Mode::Volume;
+    let has_volume = matches!(args.mode, Mode::Volume | Mode::VolBs);
+    Ok(render_settings(args).validate(has_model, has_volume)?)
 }
 
-/// The ray tracing modality the flags ask for (`None`: the plain headlight / volume modes).
-pub(crate) fn modality(args: &RenderArgs) -> Option<Modality> {
+/// The modality the flags ask for (`Headlight`: the plain b&s / volume / vol+bs modes).
+pub(crate) fn modality(args: &RenderArgs) -> Modality {
     if args.mode == Mode::Path {
-        return Some(Modality::Path {
-            material: match args.material {
-                MaterialArg::Metal => Material::Metal,
-                MaterialArg::Diffuse => Material::Diffuse,
-            },
+        return Modality::Path {
+            material: args.material,
             max_depth: args.max_depth,
             roughness: args.roughness,
-        });
+        };
     }
     if let Some(n) = args.ao {
-        return Some(Modality::Ao {
+        return Modality::Ao {
             samples: n,
             distance: args.ao_distance,
-        });
+        };
     }
     if args.shadows {
-        return Some(Modality::Direct { shadows: true });
+        return Modality::Direct { shadows: true };
     }
-    None
+    Modality::Headlight
 }
 
 /// Suffix naming the modality in reports.
 fn modality_name(args: &RenderArgs) -> String {
     match modality(args) {
-        Some(Modality::Path { material, .. }) => format!(" {material:?}").to_lowercase(),
-        Some(Modality::Ao { samples, distance }) => format!(" ao {samples}x{distance}Å"),
-        Some(Modality::Direct { .. }) => {
+        Modality::Path { material, .. } => format!(" {material:?}").to_lowercase(),
+        Modality::Ao { samples, distance } => format!(" ao {samples}x{distance}Å"),
+        Modality::Direct { .. } => {
             if args.volume_shadows {
                 " shadows (volume-attenuated)".into()
             } else {
                 " shadows".into()
             }
         }
-        Some(Modality::Headlight) | None => String::new(),
+        Modality::Headlight => String::new(),
     }
 }

@@ -246,6 +246,9 @@ fn render_modalities_write_pngs_and_refuse_what_is_missing() {
             "-o",
         ])
         .arg(dir.join("y.png")));
-    assert!(!ok && err.contains("choose one"), "{err}");
+    assert!(
+        !ok && err.contains("'--shadows' cannot be used with '--ao"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -172,7 +172,7 @@ fn functions(dump: &str) -> Vec<(&str, Vec<&str>)> {
 
 /// Builds the three executables into `target/asm` with v0 mangling and returns their
 /// paths.
-fn build(root: &std::path::Path) -> Result<Vec<(Binary, PathBuf)>> {
+fn build() -> Result<Vec<(Binary, PathBuf)>> {
     let mut c = super::cargo();
     c.args([
         "build",
@@ -188,11 +188,10 @@ fn build(root: &std::path::Path) -> Result<Vec<(Binary, PathBuf)>> {
         "--bench",
         "volume",
         "--message-format=json-render-diagnostics",
-        "--target-dir",
     ])
-    .arg(root.join("target").join("asm"))
-    .env("RUSTFLAGS", "-C symbol-mangling-version=v0");
-    eprintln!("xtask: cargo build --release (bnsview, kernels and volume benches) into target/asm, v0 mangling");
+    // v0 mangling comes from .cargo/config.toml, which RUSTFLAGS would override.
+    .env_remove("RUSTFLAGS");
+    eprintln!("xtask: cargo build --release (bnsview, kernels and volume benches), v0 mangling");
     let out = c
         .stderr(std::process::Stdio::inherit())
         .output()
@@ -243,8 +242,8 @@ fn objdump(exe: &std::path::Path) -> Result<String> {
 }
 
 /// Runs [`RULES`] for every backend.
-pub fn check(root: &std::path::Path) -> Result<Vec<AsmRow>> {
-    let bins = build(root)?;
+pub fn check() -> Result<Vec<AsmRow>> {
+    let bins = build()?;
     let mut dumps = Vec::new();
     for (b, exe) in &bins {
         dumps.push((*b, objdump(exe)?));
@@ -308,8 +307,8 @@ pub fn print_rows(rows: &[AsmRow]) {
 
 /// `cargo xtask asm <pattern>`: the disassembly of every function whose demangled header
 /// contains `pattern`, from all checked executables.
-pub fn print_matching(root: &std::path::Path, pattern: &str) -> Result<()> {
-    let bins = build(root)?;
+pub fn print_matching(pattern: &str) -> Result<()> {
+    let bins = build()?;
     let mut n = 0;
     for (b, exe) in &bins {
         let dump = objdump(exe)?;

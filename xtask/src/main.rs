@@ -24,14 +24,14 @@ fn main() -> Result<()> {
         Some("matrix") => matrix(args[1..].iter().any(|a| a == "--quick")),
         Some("bench") => bench(&args[1..]),
         Some("asm-check") => {
-            let rows = asm::check(&root())?;
+            let rows = asm::check()?;
             asm::print_rows(&rows);
             if !rows.iter().all(|r| r.ok) {
                 bail!("asm-check: some entry points failed (see above)");
             }
             Ok(())
         }
-        Some("asm") if args.len() == 2 => asm::print_matching(&root(), &args[1]),
+        Some("asm") if args.len() == 2 => asm::print_matching(&args[1]),
         _ => {
             eprintln!("usage: cargo xtask matrix [--quick] | cargo xtask bench [BENCH ARGS]");
             eprintln!("       cargo xtask asm-check | cargo xtask asm <PATTERN>");
@@ -247,7 +247,17 @@ fn matrix(quick: bool) -> Result<()> {
 
     // 2. Criterion kernel benches; each bench covers every supported ISA.
     let mut c = cargo();
-    c.args(["bench", "--workspace", "--bench", "*", "--", "--noplot"]);
+    // The release profile (not `bench`, which would compile the workspace a second time).
+    c.args([
+        "bench",
+        "--profile",
+        "release",
+        "--workspace",
+        "--bench",
+        "*",
+        "--",
+        "--noplot",
+    ]);
     if quick {
         c.arg("--quick");
     }
@@ -259,7 +269,7 @@ fn matrix(quick: bool) -> Result<()> {
     // 3. Code generation: every backend's entry points listed in `asm::RULES` must use that
     //    backend's registers and call no vector op or hot helper out of line (a generic op
     //    that was not inlined into the `#[target_feature]` entry point would be a call).
-    let asm_rows = asm::check(&root())?;
+    let asm_rows = asm::check()?;
     all_ok &= asm_rows.iter().all(|r| r.ok);
 
     // 4. Portable builds: the same binary must select the widest backend at run time
@@ -279,18 +289,20 @@ fn matrix(quick: bool) -> Result<()> {
     {
         // The default build is the x86-64 baseline; the others get their own target dir
         // because RUSTFLAGS rebuild every dependency.
-        let (dir, flags) = if cpu == "x86-64" {
-            (root().join("target"), String::new())
-        } else {
-            (
-                root().join(format!("target-cpu-{cpu}")),
-                format!("-C target-cpu={cpu}"),
-            )
-        };
         let mut c = cargo();
-        c.args(["build", "--release", "--bin", "bnsview", "--target-dir"])
-            .arg(&dir)
-            .env("RUSTFLAGS", flags);
+        c.args(["build", "--release", "--bin", "bnsview", "--target-dir"]);
+        let dir = if cpu == "x86-64" {
+            // The default build: .cargo/config.toml's flags, which RUSTFLAGS would override.
+            c.env_remove("RUSTFLAGS");
+            root().join("target")
+        } else {
+            c.env(
+                "RUSTFLAGS",
+                format!("-C target-cpu={cpu} -C symbol-mangling-version=v0"),
+            );
+            root().join(format!("target-cpu-{cpu}"))
+        };
+        c.arg(&dir);
         let (ok, _) = run_logged(c, &format!("cargo build --release (target-cpu={cpu})"))?;
         let runnable = cpu_can_run(cpu);
         let selected = if ok && runnable {

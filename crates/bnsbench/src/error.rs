@@ -4,9 +4,6 @@ use std::path::PathBuf;
 
 use crate::mode::TableSel;
 
-/// An error of the application's side of the [`crate::Pipeline`] seam (reading, building).
-pub type PipelineError = Box<dyn std::error::Error + Send + Sync + 'static>;
-
 /// Why a benchmark run or report failed.
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
@@ -36,9 +33,15 @@ pub enum BenchError {
     /// A rayon thread pool could not be built.
     #[error("building a thread pool")]
     ThreadPool(#[source] rayon::ThreadPoolBuildError),
-    /// A modality mode was planned without ball-and-stick geometry.
-    #[error("a modality mode without ball-and-stick geometry")]
-    NoGeometry,
+    /// A mode's render settings were refused for what the scene holds.
+    #[error("render settings")]
+    Settings(#[source] render::SettingsError),
+    /// Generating the atoms was refused (too many for this machine).
+    #[error("generating the scene")]
+    Generate(#[source] molecule::scenes::SceneError),
+    /// Building the bonds, model or volume failed.
+    #[error("building the scene")]
+    Scene(#[source] scene::SceneError),
     /// Reading a file failed.
     #[error("reading {}", .0.display())]
     Read(PathBuf, #[source] std::io::Error),
@@ -67,9 +70,6 @@ pub enum BenchError {
         /// `scene: error` per failure, `; ` separated.
         list: String,
     },
-    /// The application's pipeline failed.
-    #[error(transparent)]
-    Pipeline(PipelineError),
 }
 
 /// `e` and its sources, `: ` separated (as anyhow's `{:#}`).

@@ -7,8 +7,9 @@
 //! paper's figures ([`paper`]) beside ours (whole machine and per core); [`json`] writes every
 //! measurement as JSON and reads earlier runs back.
 //!
-//! The application supplies scene building and render settings through the [`Pipeline`]
-//! trait, so that this crate does not depend on how the CLI spells its flags.
+//! Scenes are built by the `scene` crate and frames rendered by the `render` crate's one
+//! driver with [`BenchMode::settings`], the settings `bnsview render` uses for the same
+//! picture (the CLI's tests check the two agree flag for flag).
 #![warn(missing_docs)]
 
 pub mod error;
@@ -23,8 +24,7 @@ pub mod record;
 pub mod report;
 pub mod run;
 
-pub use error::{BenchError, PipelineError};
-pub use measure::{FrameSetup, Loaded, Pipeline};
+pub use error::BenchError;
 pub use mode::{expand_modes, BenchMode, ModeSel, TableSel};
 pub use plan::{plan, Key, PlanSpec, Tables};
 pub use record::{Measurement, Preprocess};

@@ -3,6 +3,9 @@
 
 use std::str::FromStr;
 
+use render::{Material, Modality, RenderSettings, DARK_BACKGROUND, WHITE_BACKGROUND};
+use volume::{Light, Lighting, MarchOptions};
+
 /// What a benchmark frame shows: the rows of the paper's Table 3, lit volume alone, and the
 /// ray tracing modalities of §4.5 / Figure 4 (one sample per pixel per frame).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -135,6 +138,81 @@ impl BenchMode {
         BenchMode::PAPER.iter().position(|&m| m == self)
     }
 
+    /// How the frame is shaded: the settings `bnsview render` uses for the same picture
+    /// (default light, AO distance and material; dark background except plain ball-and-stick
+    /// modes), with one sample per pixel (`--ao 1`, `--spp 1`). The volume pass's options are
+    /// `settings().march`.
+    pub fn settings(self) -> RenderSettings {
+        use BenchMode::*;
+        let d = RenderSettings::default();
+        let shadows = Some(volume::VolumeShadows {
+            light: d.light,
+            step_voxels: d.shadow_step_voxels,
+        });
+        let march = |lighting, shadows| MarchOptions {
+            lighting,
+            shadows,
+            ..MarchOptions::default()
+        };
+        let direct = Modality::Direct { shadows: true };
+        let dir = match d.light {
+            Light::Directional(v) => Lighting::Directional(v),
+            Light::Point(p) => Lighting::Point(p),
+        };
+        let (modality, march, background) = match self {
+            Bs => (
+                Modality::Headlight,
+                march(Lighting::Unlit, None),
+                WHITE_BACKGROUND,
+            ),
+            Volume | VolBs => (
+                Modality::Headlight,
+                march(Lighting::Unlit, None),
+                DARK_BACKGROUND,
+            ),
+            VolBsLit | VolumeLit => (
+                Modality::Headlight,
+                march(Lighting::Headlight, None),
+                DARK_BACKGROUND,
+            ),
+            VolumeShadows => (
+                Modality::Headlight,
+                march(Lighting::Unlit, shadows),
+                DARK_BACKGROUND,
+            ),
+            VolumeLitShadows => (Modality::Headlight, march(dir, shadows), DARK_BACKGROUND),
+            BsShadows => (direct, march(Lighting::Unlit, None), WHITE_BACKGROUND),
+            BsAo => (
+                Modality::Ao {
+                    samples: 1,
+                    distance: 4.0,
+                },
+                march(Lighting::Unlit, None),
+                WHITE_BACKGROUND,
+            ),
+            Path => (
+                Modality::Path {
+                    material: Material::Metal,
+                    max_depth: 6,
+                    roughness: 0.15,
+                },
+                march(Lighting::Unlit, None),
+                DARK_BACKGROUND,
+            ),
+            VolBsShadows => (direct, march(Lighting::Unlit, shadows), DARK_BACKGROUND),
+        };
+        let base = match modality {
+            Modality::Headlight => RenderSettings::headlight(background),
+            m => RenderSettings::traced(m, background),
+        };
+        RenderSettings {
+            march,
+            spp: 1,
+            volume_shadows: march.shadows.is_some(),
+            ..base
+        }
+    }
+
     /// Random samples per pixel of one frame (AO rays, paths), for the stochastic modes.
     pub fn samples_per_pixel(self) -> Option<u32> {
         match self {
@@ -246,6 +324,22 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), BenchMode::ALL.len());
         assert!("shadows".parse::<BenchMode>().is_err());
+    }
+
+    #[test]
+    fn every_mode_settings_are_valid_for_what_it_draws() {
+        for m in BenchMode::ALL {
+            let s = m.settings();
+            assert_eq!(s.validate(m.geometry(), m.volume()), Ok(()), "{m:?}");
+            // The stochastic modes are the ray-traced ones that sample at random.
+            let random = matches!(s.modality, Modality::Ao { .. } | Modality::Path { .. });
+            assert_eq!(m.samples_per_pixel().is_some(), random, "{m:?}");
+            assert_eq!(s.frame_samples(), 1, "{m:?}");
+            assert_eq!(
+                s.march.shadows.is_some(),
+                m.name().contains("shadows") && m.volume()
+            );
+        }
     }
 
     #[test]

@@ -7,21 +7,30 @@ use std::time::Instant;
 
 use molecule::scenes::SceneName;
 use render::Framebuffer;
+use scene::ModelSettings;
 use spmd::Isa;
+use volume::TransferFunction;
 
 use crate::error::{chain, BenchError};
 use crate::json::{document, read_report, write_json, RunInfo};
-use crate::measure::{Pipeline, Session};
+use crate::measure::Session;
 use crate::plan::{plan, sidx, Key, PlanSpec, Tables};
 use crate::probe::{cpu_model, load_avg, nproc};
 use crate::record::{Measurement, Preprocess};
 use crate::report::report;
 
-/// Everything a run needs besides the [`Pipeline`] and the ISAs.
+/// Everything a run needs besides the ISAs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     /// What to measure.
     pub spec: PlanSpec,
+    /// Seed of the scene generators.
+    pub seed: u64,
+    /// How the balls and sticks are drawn (`wide_bvh` is ignored: the modes' traversals
+    /// build what they need).
+    pub model: ModelSettings,
+    /// Transfer function of the volume modes.
+    pub tf: TransferFunction,
     /// Timed frames per measurement, after the warm-up (default 10, quick 3).
     pub frames: Option<usize>,
     /// Warm-up frames before timing.
@@ -59,10 +68,10 @@ fn check_json_path(cfg: &Config) -> Result<(), BenchError> {
     Ok(())
 }
 
-/// Runs the benchmark of `cfg` on the backends `isas`, rendering through `pipeline`; prints
+/// Runs the benchmark of `cfg` on the backends `isas`; prints
 /// progress to stderr and the report to stdout. Scenes that fail are reported at the end
 /// ([`BenchError::ScenesFailed`]) after the others were measured.
-pub fn run(cfg: &Config, isas: &[Isa], pipeline: &dyn Pipeline) -> Result<(), BenchError> {
+pub fn run(cfg: &Config, isas: &[Isa]) -> Result<(), BenchError> {
     if isas.is_empty() {
         return Err(BenchError::NoIsa);
     }
@@ -76,7 +85,6 @@ pub fn run(cfg: &Config, isas: &[Isa], pipeline: &dyn Pipeline) -> Result<(), Be
     if plan.is_empty() {
         return Err(BenchError::NothingToMeasure(cfg.spec.table));
     }
-    let tf = pipeline.transfer_function().map_err(BenchError::Pipeline)?;
     // Frame buffers are allocated per measurement; check the largest fits first.
     for (k, _) in &plan {
         Framebuffer::new(k.w, k.h, 0).map_err(|e| BenchError::Frame(k.w, k.h, e))?;
@@ -114,9 +122,7 @@ pub fn run(cfg: &Config, isas: &[Isa], pipeline: &dyn Pipeline) -> Result<(), Be
     };
     let mut session = Session {
         cfg,
-        pipeline,
         isas,
-        tf: &tf,
         frames,
         pools: BTreeMap::new(),
         done: 0,
@@ -225,47 +231,7 @@ pub fn run_report(files: &[PathBuf]) -> Result<(), BenchError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::PipelineError;
-    use crate::measure::{FrameSetup, Loaded};
-    use crate::mode::{BenchMode, TableSel};
-    use molecule::Molecule;
-    use render::Model;
-    use volume::{LightVolume, Macrocells, MarchOptions, TransferFunction, Volume, VolumeScene};
-
-    /// A pipeline the refused runs must never reach.
-    struct Unreachable;
-
-    impl Pipeline for Unreachable {
-        fn load(&self, _: SceneName, _: usize) -> Result<Loaded, PipelineError> {
-            unreachable!()
-        }
-        fn model(&self, _: &Molecule, _: &[[u32; 2]]) -> Result<Model, PipelineError> {
-            unreachable!()
-        }
-        fn sphere(&self, _: &Molecule) -> ([f32; 3], f32) {
-            unreachable!()
-        }
-        fn volume(
-            &self,
-            _: Isa,
-            _: &Molecule,
-            _: f32,
-        ) -> Result<(Volume, Macrocells, f64), PipelineError> {
-            unreachable!()
-        }
-        fn transfer_function(&self) -> Result<TransferFunction, PipelineError> {
-            Err("no transfer function here".into())
-        }
-        fn march_options(&self, _: BenchMode) -> Result<MarchOptions, PipelineError> {
-            unreachable!()
-        }
-        fn frame_setup(&self, _: BenchMode) -> Result<FrameSetup, PipelineError> {
-            unreachable!()
-        }
-        fn light_volume(&self, _: &VolumeScene, _: Isa, _: &dyn Fn(String)) -> Option<LightVolume> {
-            unreachable!()
-        }
-    }
+    use crate::mode::TableSel;
 
     fn config() -> Config {
         Config {
@@ -274,6 +240,9 @@ mod tests {
                 table: TableSel::T3,
                 ..PlanSpec::default()
             },
+            seed: 1,
+            model: ModelSettings::default(),
+            tf: TransferFunction::preset(volume::Preset::CoolWarm),
             frames: None,
             warmup: 0,
             voxels_per_angstrom: None,
@@ -288,7 +257,7 @@ mod tests {
     #[test]
     fn bad_requests_are_refused_before_any_work() {
         let isa = [Isa::Scalar];
-        let err = |c: &Config, isas: &[Isa]| run(c, isas, &Unreachable).unwrap_err();
+        let err = |c: &Config, isas: &[Isa]| run(c, isas).unwrap_err();
         assert!(matches!(err(&config(), &[]), BenchError::NoIsa));
         let c = Config {
             frames: Some(0),
@@ -316,11 +285,6 @@ mod tests {
             ..config()
         };
         assert!(matches!(err(&c, &isa), BenchError::NoDirectory { .. }));
-        // The pipeline's error comes through with its message.
-        assert_eq!(
-            err(&config(), &isa).to_string(),
-            "no transfer function here"
-        );
     }
 
     #[test]

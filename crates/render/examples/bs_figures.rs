@@ -3,7 +3,7 @@
 
 use bvh::scenes::random_molecule;
 use bvh::Bvh;
-use render::{render_bs_into, Camera, Framebuffer, Model, RenderOptions, View};
+use render::{render_frame, Camera, FrameInputs, Framebuffer, Model, RenderSettings, View};
 use spmd::Isa;
 
 fn main() {
@@ -43,7 +43,7 @@ fn main() {
         st.sah_cost,
         st.bytes_per_atom()
     );
-    let ro = RenderOptions::default();
+    let ro = RenderSettings::default();
     let mut fb = Framebuffer::new(1024, 1024, 0).unwrap();
     // ISAs interleaved frame by frame (other processes load them alike); 10 frames after one
     // warm-up frame each; median and best.
@@ -52,12 +52,13 @@ fn main() {
         let isas = Isa::supported();
         let mut times = vec![Vec::new(); isas.len()];
         for isa in &isas {
-            render_bs_into(&scene, &cam, &mut fb, &ro, *isa);
+            render_frame(&FrameInputs::geometry(&scene, &cam), &ro, &mut fb, *isa).unwrap();
         }
         for _ in 0..10 {
             for (k, isa) in isas.iter().enumerate() {
                 times[k].push(
-                    render_bs_into(&scene, &cam, &mut fb, &ro, *isa)
+                    render_frame(&FrameInputs::geometry(&scene, &cam), &ro, &mut fb, *isa)
+                        .unwrap()
                         .time
                         .as_secs_f64(),
                 );
@@ -76,7 +77,13 @@ fn main() {
             );
         }
         if let Some(out) = args.get(2) {
-            render_bs_into(&scene, &cam, &mut fb, &ro, Isa::detect());
+            render_frame(
+                &FrameInputs::geometry(&scene, &cam),
+                &ro,
+                &mut fb,
+                Isa::detect(),
+            )
+            .unwrap();
             fb.save_png(format!("{out}-{view:?}.png")).unwrap();
         }
     }

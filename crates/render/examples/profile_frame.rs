@@ -1,6 +1,6 @@
 //! Renders frames in a loop for profiling: `profile_frame [atoms] [frames] [isa] [regs]`.
 use bvh::scenes::random_molecule;
-use render::{render_bs_into, Camera, Framebuffer, Model, RenderOptions, View};
+use render::{render_frame, Camera, FrameInputs, Framebuffer, Model, RenderSettings, View};
 use spmd::Isa;
 
 fn main() {
@@ -28,12 +28,13 @@ fn main() {
         let mut times = vec![Vec::new(); configs.len()];
         for _ in 0..frames {
             for (c, &(isa, r)) in configs.iter().enumerate() {
-                let ro = RenderOptions {
+                let ro = RenderSettings {
                     packet_registers: r,
                     ..Default::default()
                 };
                 times[c].push(
-                    render_bs_into(&scene, &cam, &mut fb, &ro, isa)
+                    render_frame(&FrameInputs::geometry(&scene, &cam), &ro, &mut fb, isa)
+                        .unwrap()
                         .time
                         .as_secs_f64(),
                 );

@@ -32,6 +32,17 @@ pub struct FrameInputs<'a> {
     pub camera: &'a Camera,
 }
 
+impl<'a> FrameInputs<'a> {
+    /// Ball-and-stick geometry alone, seen by `camera`.
+    pub fn geometry(model: &'a Model, camera: &'a Camera) -> FrameInputs<'a> {
+        FrameInputs {
+            model: Some(model),
+            volume: None,
+            camera,
+        }
+    }
+}
+
 /// Which tiles (16×16, numbered `tx` across and `ty` down) a call renders.
 #[derive(Clone, Copy)]
 pub enum TileSet<'a> {

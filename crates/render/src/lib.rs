@@ -14,7 +14,6 @@ mod camera_rays;
 mod driver;
 mod framebuffer;
 mod integrator;
-mod legacy;
 mod rng;
 mod settings;
 
@@ -25,15 +24,11 @@ pub use driver::{
 };
 pub use framebuffer::{Framebuffer, RenderError};
 pub use integrator::{trace, Traced};
-pub use legacy::{
-    render_bs, render_bs_into, render_frame_into, render_modal, render_modal_into, RenderOptions,
-    TraceOptions,
-};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };
 pub use settings::{
-    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DIRECT_AMBIENT,
-    HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP,
+    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,
+    DIRECT_AMBIENT, HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP, WHITE_BACKGROUND,
 };
 pub use volume::Light;

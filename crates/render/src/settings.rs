@@ -8,6 +8,11 @@ use volume::{Light, Lighting, MarchOptions};
 pub const HEADLIGHT_AMBIENT: f32 = 0.15;
 /// Ambient term of [`Modality::Direct`]: colour × (ambient + intensity·max(0, n·l)·V).
 pub const DIRECT_AMBIENT: f32 = 0.2;
+/// Background of the volume modes and of path tracing unless one is given (RGB 0-255): near
+/// black, so that the volume's colours and the path tracer's environment stay readable.
+pub const DARK_BACKGROUND: [u8; 3] = [12, 12, 20];
+/// Background of the ball-and-stick modes unless one is given (RGB 0-255).
+pub const WHITE_BACKGROUND: [u8; 3] = [255, 255, 255];
 /// Cap on samples per pixel: 65,536 samples of a 1024² frame are ~7·10¹⁰ camera paths
 /// (hours); accumulate in several calls ([`crate::accumulate`]) to go further.
 pub const MAX_SPP: u32 = 65_536;
@@ -18,6 +23,7 @@ pub const MAX_DEPTH: u32 = 64;
 
 /// BRDF of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Material {
     /// Lambertian, albedo = atom colour.
     Diffuse,
@@ -78,6 +84,7 @@ pub enum Modality {
 /// 3.33 s). Defaults: [`RenderSettings::secondary`] `Packet`, [`RenderSettings::bounces`]
 /// `Wide`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum SecondaryTraversal {
     /// The rays of a pixel block as one packet over the binary BVH (any-hit early exit for
     /// shadow and AO rays).

@@ -5,12 +5,31 @@
 use bvh::scenes::random_molecule;
 use bvh::{Balls, Geometry, Ray, Sticks};
 use render::{
-    ambient_occlusion_at, render_modal, rgba, Camera, Framebuffer, Light, Material, Modality,
-    Model, SecondaryTraversal, TraceOptions, View,
+    accumulate, ambient_occlusion_at, rgba, Accum, Camera, FrameInputs, Framebuffer, Light,
+    Material, Modality, Model, RenderSettings, SecondaryTraversal, View, WHITE_BACKGROUND,
 };
 use spmd::Isa;
 
 const WHITE: u32 = rgba(255, 255, 255, 255);
+
+/// Direct light with shadows on white, every other setting its default.
+fn traced() -> RenderSettings {
+    RenderSettings::traced(Modality::Direct { shadows: true }, WHITE_BACKGROUND)
+}
+
+/// `spp` samples of `set` accumulated over a new `w × h` frame: the picture and the sums.
+fn render_modal(
+    scene: &Model,
+    cam: &Camera,
+    (w, h): (u32, u32),
+    set: &RenderSettings,
+    spp: u32,
+    isa: Isa,
+) -> (Framebuffer, Accum) {
+    let mut acc = Accum::new(w, h).unwrap();
+    accumulate(&FrameInputs::geometry(scene, cam), set, &mut acc, spp, isa).unwrap();
+    (acc.to_framebuffer(set.is_linear(), set.exposure), acc)
+}
 
 fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Model {
     let g = Geometry {
@@ -75,12 +94,12 @@ fn check_shadow(light: Light, clearance: impl Fn([f64; 3]) -> Option<f64>) {
     let scene = sphere_over_slab();
     let cam = Camera::orthographic([0.0, 30.0, 22.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 22.0);
     let (w, h) = (128, 128);
-    let opt = TraceOptions {
+    let opt = RenderSettings {
         modality: Modality::Direct { shadows: true },
         light,
         light_intensity: 0.8,
         ambient: 0.2,
-        ..TraceOptions::default()
+        ..traced()
     };
     let ambient = (0.2f32 * 255.0 + 0.5) as i32;
     let slab_prims = (scene.geometry.balls.len() - 1) as u32;
@@ -90,8 +109,8 @@ fn check_shadow(light: Light, clearance: impl Fn([f64; 3]) -> Option<f64>) {
             SecondaryTraversal::Single,
             SecondaryTraversal::Wide,
         ] {
-            let opt = TraceOptions { secondary, ..opt };
-            let (fb, _, _) = render_modal(&scene, None, &cam, w, h, &opt, 1, isa).unwrap();
+            let opt = RenderSettings { secondary, ..opt };
+            let (fb, _) = render_modal(&scene, &cam, (w, h), &opt, 1, isa);
             let (mut n_shadow, mut n_lit) = (0, 0);
             for y in 0..h {
                 for x in 0..w {
@@ -175,12 +194,12 @@ fn point_light_shadow_is_the_cone_from_the_light() {
 fn shadows_off_means_no_shadow() {
     let scene = sphere_over_slab();
     let cam = Camera::orthographic([0.0, 30.0, 22.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 22.0);
-    let opt = TraceOptions {
+    let opt = RenderSettings {
         modality: Modality::Direct { shadows: false },
         light: Light::Directional([0.0, 1.0, 0.0]),
-        ..TraceOptions::default()
+        ..traced()
     };
-    let (fb, _, _) = render_modal(&scene, None, &cam, 64, 64, &opt, 1, Isa::detect()).unwrap();
+    let (fb, _) = render_modal(&scene, &cam, (64, 64), &opt, 1, Isa::detect());
     // The slab right under the sphere (image centre, below the sphere's silhouette) is lit.
     let ray = ortho_ray(&cam, 64, 64, 32, 40);
     let hit = scene.bvh.intersect_ray(&ray).unwrap();
@@ -251,16 +270,16 @@ fn fib(i: usize, n: usize) -> [f32; 3] {
 fn ao_image_of_an_unoccluded_sphere_is_its_colour() {
     let scene = balls(&[[0.0, 0.0, 0.0]], &[2.0], &[rgba(200, 120, 40, 255)]);
     let cam = Camera::view(View::Far, scene.center, scene.radius, 40.0, 1.0);
-    let opt = TraceOptions {
+    let opt = RenderSettings {
         modality: Modality::Ao {
             samples: 16,
             distance: 50.0,
         },
-        background: [0.0, 0.0, 0.0],
-        ..TraceOptions::default()
+        background: [0, 0, 0],
+        ..traced()
     };
     for isa in Isa::under_test() {
-        let (fb, _, _) = render_modal(&scene, None, &cam, 64, 64, &opt, 1, isa).unwrap();
+        let (fb, _) = render_modal(&scene, &cam, (64, 64), &opt, 1, isa);
         let hit = fb
             .pixels
             .iter()
@@ -287,18 +306,18 @@ fn furnace_white_diffuse_under_white_sky_is_one() {
     let r: Vec<f32> = g.balls.radius.iter().map(|r| r * 1.5).collect();
     let scene = balls(&centres, &r, &vec![WHITE; centres.len()]);
     let cam = Camera::view(View::Far, scene.center, scene.radius, 40.0, 1.0);
-    let opt = TraceOptions {
+    let opt = RenderSettings {
         modality: Modality::Path {
             material: Material::Diffuse,
             max_depth: 64,
             roughness: 0.0,
         },
         light_intensity: 0.0,
-        background: [1.0, 1.0, 1.0],
-        ..TraceOptions::default()
+        background: [255, 255, 255],
+        ..traced()
     };
     for isa in Isa::under_test() {
-        let (_, acc, _) = render_modal(&scene, None, &cam, 48, 48, &opt, 8, isa).unwrap();
+        let (_, acc) = render_modal(&scene, &cam, (48, 48), &opt, 8, isa);
         let mut lo = f32::INFINITY;
         let mut sum = 0.0f64;
         for y in 0..48 {
@@ -324,17 +343,17 @@ fn single_ball_under_white_sky_returns_its_albedo() {
     let cam = Camera::view(View::Far, scene.center, scene.radius, 40.0, 1.0);
     let albedo = (128.0f32 / 255.0).powi(2);
     for material in [Material::Diffuse, Material::Metal] {
-        let opt = TraceOptions {
+        let opt = RenderSettings {
             modality: Modality::Path {
                 material,
                 max_depth: 4,
                 roughness: 0.0,
             },
             light_intensity: 0.0,
-            background: [1.0, 1.0, 1.0],
-            ..TraceOptions::default()
+            background: [255, 255, 255],
+            ..traced()
         };
-        let (_, acc, _) = render_modal(&scene, None, &cam, 64, 64, &opt, 4, Isa::detect()).unwrap();
+        let (_, acc) = render_modal(&scene, &cam, (64, 64), &opt, 4, Isa::detect());
         // The centre of the ball (normal incidence): metal's Fresnel factor is F0 there too.
         let c = acc.mean(32, 32);
         assert!(
@@ -430,22 +449,21 @@ fn every_backend_matches_scalar_for_a_fixed_seed() {
     ];
     for (modality, spp, need) in cases {
         // The reference: scalar, every secondary ray in (one-lane) packets of the binary BVH.
-        let opt = TraceOptions {
+        let opt = RenderSettings {
             modality,
             seed: 42,
             secondary: SecondaryTraversal::Packet,
             bounces: SecondaryTraversal::Packet,
-            ..TraceOptions::default()
+            ..traced()
         };
-        let (reference, _, _) =
-            render_modal(&scene, None, &cam, w, h, &opt, spp, Isa::Scalar).unwrap();
+        let (reference, _) = render_modal(&scene, &cam, (w, h), &opt, spp, Isa::Scalar);
         let bg = reference.pixels.iter().filter(|&&p| p == WHITE).count();
         assert!(
             bg < reference.pixels.len() * 9 / 10,
             "{modality:?}: nearly empty"
         );
         // Same seed twice: identical; another seed: a different picture (AO/path).
-        let (again, _, _) = render_modal(&scene, None, &cam, w, h, &opt, spp, Isa::Scalar).unwrap();
+        let (again, _) = render_modal(&scene, &cam, (w, h), &opt, spp, Isa::Scalar);
         assert_eq!(again, reference);
         // Every backend and every traversal of the secondary rays (shadow, AO, bounces).
         for isa in Isa::under_test() {
@@ -454,12 +472,12 @@ fn every_backend_matches_scalar_for_a_fixed_seed() {
                 SecondaryTraversal::Single,
                 SecondaryTraversal::Wide,
             ] {
-                let opt = TraceOptions {
+                let opt = RenderSettings {
                     secondary: how,
                     bounces: how,
                     ..opt
                 };
-                let (fb, _, _) = render_modal(&scene, None, &cam, w, h, &opt, spp, isa).unwrap();
+                let (fb, _) = render_modal(&scene, &cam, (w, h), &opt, spp, isa);
                 let (frac, mean) = compare(&reference, &fb, 2);
                 assert!(
                     frac >= need && mean < 0.5,
@@ -475,34 +493,32 @@ fn every_backend_matches_scalar_for_a_fixed_seed() {
 fn progressive_accumulation_does_not_depend_on_how_samples_are_split() {
     let scene = molecule_scene();
     let cam = Camera::view(View::Far, scene.center, scene.radius, 40.0, 1.0);
-    let opt = TraceOptions {
+    let opt = RenderSettings {
         modality: Modality::Path {
             material: Material::Diffuse,
             max_depth: 3,
             roughness: 0.0,
         },
-        ..TraceOptions::default()
+        ..traced()
     };
     let isa = Isa::detect();
-    let (_, all, _) = render_modal(&scene, None, &cam, 40, 40, &opt, 4, isa).unwrap();
-    let mut acc = render::Accum::new(40, 40).unwrap();
-    render::render_modal_into(&scene, None, &cam, &mut acc, &opt, 1, isa);
-    render::render_modal_into(&scene, None, &cam, &mut acc, &opt, 3, isa);
+    let (_, all) = render_modal(&scene, &cam, (40, 40), &opt, 4, isa);
+    let mut acc = Accum::new(40, 40).unwrap();
+    let inputs = FrameInputs::geometry(&scene, &cam);
+    accumulate(&inputs, &opt, &mut acc, 1, isa).unwrap();
+    accumulate(&inputs, &opt, &mut acc, 3, isa).unwrap();
     assert_eq!(acc.samples, 4);
     for (a, b) in acc.rgb.iter().zip(&all.rgb) {
         assert!((a - b).abs() <= 1e-5 * b.abs().max(1.0), "{a} vs {b}");
     }
     // A different seed gives a different picture.
-    let (_, other, _) = render_modal(
+    let (_, other) = render_modal(
         &scene,
-        None,
         &cam,
-        40,
-        40,
-        &TraceOptions { seed: 2, ..opt },
+        (40, 40),
+        &RenderSettings { seed: 2, ..opt },
         4,
         isa,
-    )
-    .unwrap();
+    );
     assert_ne!(other.rgb, all.rgb);
 }

@@ -1,10 +1,11 @@
 //! Rendering: backends agree with scalar; analytic sphere and cylinder; big frames; PNG.
 
+mod common;
 use bvh::scenes::random_molecule;
 use bvh::{Balls, Geometry, Ray, Sticks};
+use common::render_bs;
 use render::{
-    render_bs, rgba, Camera, Coloring, Colormap, Framebuffer, Model, ModelOptions, RenderOptions,
-    Style, View,
+    rgba, Camera, Coloring, Colormap, Framebuffer, Model, ModelOptions, RenderSettings, Style, View,
 };
 use spmd::Isa;
 
@@ -46,12 +47,12 @@ fn every_backend_matches_scalar() {
         for view in [View::Far, View::Close] {
             let (w, h) = (203, 150);
             let cam = Camera::view(view, scene.center, scene.radius, 40.0, w as f32 / h as f32);
-            let ro = RenderOptions::default();
-            let (reference, _) = render_bs(&scene, &cam, w, h, &ro, Isa::Scalar).unwrap();
+            let ro = RenderSettings::default();
+            let (reference, _) = render_bs(&scene, &cam, w, h, &ro, Isa::Scalar);
             let bg = reference
                 .pixels
                 .iter()
-                .filter(|&&p| p == ro.background)
+                .filter(|&&p| p == ro.background_packed())
                 .count();
             assert!(
                 bg < reference.pixels.len() * 95 / 100,
@@ -59,7 +60,7 @@ fn every_backend_matches_scalar() {
             );
             assert!(bg > 0 || view == View::Close);
             for isa in Isa::supported() {
-                let (fb, stats) = render_bs(&scene, &cam, w, h, &ro, isa).unwrap();
+                let (fb, stats) = render_bs(&scene, &cam, w, h, &ro, isa);
                 assert_eq!(stats.isa, isa);
                 let a = agree(&reference, &fb);
                 assert!(
@@ -172,13 +173,13 @@ fn analytic_shading_orthographic() {
     let scene = sphere_and_cylinder();
     let (w, h) = (64u32, 64u32);
     let cam = Camera::orthographic([0.0, 0.0, 10.0], [0.0; 3], [0.0, 1.0, 0.0], 2.5);
-    let ro = RenderOptions {
-        background: rgba(0, 0, 0, 255),
+    let ro = RenderSettings {
+        background: [0, 0, 0],
         ambient: 0.2,
         ..Default::default()
     };
     for isa in Isa::supported() {
-        let (fb, _) = render_bs(&scene, &cam, w, h, &ro, isa).unwrap();
+        let (fb, _) = render_bs(&scene, &cam, w, h, &ro, isa);
         let mut checked = 0;
         for py in 0..h {
             for px in 0..w {
@@ -236,10 +237,9 @@ fn scalar_colormap_and_png() {
         &cam,
         100,
         100,
-        &RenderOptions::default(),
+        &RenderSettings::default(),
         Isa::detect(),
-    )
-    .unwrap();
+    );
     let dir = std::env::temp_dir().join(format!("bnsview-render-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("t.png");
@@ -259,10 +259,9 @@ fn huge_framebuffer() {
         &cam,
         16384,
         16384,
-        &RenderOptions::default(),
+        &RenderSettings::default(),
         Isa::detect(),
-    )
-    .unwrap();
+    );
     assert_eq!(fb.pixels.len(), 16384 * 16384);
     assert_eq!(stats.rays, 16384 * 16384);
     // The centre of the frame is near the scene centre (between sphere and cylinder): somewhere

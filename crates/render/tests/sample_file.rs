@@ -2,9 +2,11 @@
 //! scalar backend. The test reads the PDB itself (fixed columns, element from the atom name)
 //! and bonds by brute force, so it does not depend on the molecule crate.
 
+mod common;
+use common::render_bs;
 use std::path::PathBuf;
 
-use render::{render_bs, rgba, Camera, Model, ModelOptions, RenderOptions, Style, View};
+use render::{rgba, Camera, Model, ModelOptions, RenderSettings, Style, View};
 use spmd::Isa;
 
 fn sample(name: &str) -> PathBuf {
@@ -105,8 +107,8 @@ fn protein_renders_alike_on_every_backend() {
         scene.bvh.validate(&scene.geometry).unwrap();
         for view in [View::Far, View::Close] {
             let cam = Camera::view(view, scene.center, scene.radius, 40.0, 1.25);
-            let ro = RenderOptions::default();
-            let (reference, _) = render_bs(&scene, &cam, 250, 200, &ro, Isa::Scalar).unwrap();
+            let ro = RenderSettings::default();
+            let (reference, _) = render_bs(&scene, &cam, 250, 200, &ro, Isa::Scalar);
             if let Ok(dir) = std::env::var("BNS_TEST_IMAGES") {
                 reference
                     .save_png(format!("{dir}/adk-{style:?}-{view:?}.png"))
@@ -115,14 +117,14 @@ fn protein_renders_alike_on_every_backend() {
             let covered = reference
                 .pixels
                 .iter()
-                .filter(|&&p| p != ro.background)
+                .filter(|&&p| p != ro.background_packed())
                 .count();
             assert!(
                 covered > 2000,
                 "{style:?} {view:?}: only {covered} pixels show the protein"
             );
             for isa in Isa::supported() {
-                let (fb, _) = render_bs(&scene, &cam, 250, 200, &ro, isa).unwrap();
+                let (fb, _) = render_bs(&scene, &cam, 250, 200, &ro, isa);
                 let within = reference
                     .pixels
                     .iter()

@@ -2,10 +2,12 @@
 
 /// A colormap from `[0, 1]` to RGB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Colormap {
     /// matplotlib's viridis (9 stops, linearly interpolated).
     Viridis,
     /// Black to white.
+    #[cfg_attr(feature = "clap", value(alias = "grey"))]
     Gray,
 }
 

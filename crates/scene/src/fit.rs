@@ -1,10 +1,11 @@
 //! Camera fitting, done once for every command: the scene's bounding sphere and a camera on
 //! an orbit around its centre at the far/close distance of the paper's Table 3.
 
-use molecule::Molecule;
+use molecule::{elements, Molecule};
 
 use crate::camera::{Camera, View};
 use crate::model::Model;
+use crate::settings::{ModelSettings, RadiusKind};
 
 /// Padding (Å) of the atom-centre sphere when there is no geometry: about the support of the
 /// density around an atom (√2 × 1.4 Å).
@@ -41,6 +42,49 @@ pub fn bounding_sphere(m: &Molecule, model: Option<&Model>) -> Sphere {
     Sphere {
         center: c,
         radius: r2.sqrt() + ATOM_SPHERE_PAD,
+    }
+}
+
+/// The sphere [`Model::new`] would give `m` drawn with `ms` (centre of the balls' box, radius
+/// to the farthest ball surface, Å), without building the model: a run that renders only the
+/// volume still frames the picture as its ball-and-stick runs do (the benchmark's Table 3).
+pub fn ball_sphere(m: &Molecule, ms: &ModelSettings) -> Sphere {
+    if m.is_empty() {
+        return Sphere {
+            center: [0.0; 3],
+            radius: 1.0,
+        };
+    }
+    let r: Vec<f32> = m
+        .elements
+        .iter()
+        .map(|&z| {
+            let e = elements::element(z);
+            let base = match ms.radius {
+                RadiusKind::Covalent => e.covalent_radius,
+                RadiusKind::Vdw => e.vdw_radius,
+            };
+            (base * ms.radius_scale).max(ms.stick_radius)
+        })
+        .collect();
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for (i, &ri) in r.iter().enumerate() {
+        for (k, c) in [m.x[i], m.y[i], m.z[i]].into_iter().enumerate() {
+            lo[k] = lo[k].min(c - ri);
+            hi[k] = hi[k].max(c + ri);
+        }
+    }
+    let c: [f32; 3] = core::array::from_fn(|k| (lo[k] + hi[k]) * 0.5);
+    let radius = (0..m.len())
+        .map(|i| {
+            let d = [m.x[i] - c[0], m.y[i] - c[1], m.z[i] - c[2]].map(|v| v as f64);
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() + r[i] as f64
+        })
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max) as f32;
+    Sphere {
+        center: c,
+        radius: radius.max(1e-3),
     }
 }
 

@@ -9,18 +9,21 @@
 
 mod build;
 mod camera;
+mod camera_spec;
 mod colormap;
 mod error;
 mod fit;
 mod memory;
 mod model;
+mod report;
 mod settings;
 
 pub use build::{DensityVolume, Scene, Stage, Timings};
 pub use camera::{Camera, Projection, View};
+pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
 pub use error::SceneError;
-pub use fit::{bounding_sphere, Orbit, Sphere, ATOM_SPHERE_PAD};
+pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ATOM_SPHERE_PAD};
 pub use memory::{MemoryEstimate, BVH_NODES_PER_PRIM, WIDE_NODES_PER_PRIM};
 pub use model::{Coloring, Model, ModelOptions, Style};
 pub use settings::{

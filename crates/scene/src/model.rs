@@ -9,6 +9,7 @@ use crate::colormap::Colormap;
 
 /// How the molecule is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Style {
     /// Balls and sticks (stick ends hidden in the balls).
     BallAndStick,

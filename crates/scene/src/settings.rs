@@ -9,6 +9,7 @@ use crate::model::Style;
 
 /// Which radius of the element table sizes the balls.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum RadiusKind {
     /// Covalent radius (Cordero 2008).
     #[default]
@@ -65,6 +66,7 @@ impl Default for ModelSettings {
 
 /// Where bonds come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum BondSource {
     /// Geometric rule (uniform-grid neighbour search, [`molecule::bonds::try_build_bonds`]).
     #[default]

@@ -184,3 +184,30 @@ fn bad_settings_are_errors() {
         Err(SceneError::NoAtoms)
     ));
 }
+
+#[test]
+fn ball_sphere_is_the_models_sphere_without_building_it() {
+    // A volume-only benchmark run frames the scene as the ball-and-stick run does.
+    for style in [Style::BallAndStick, Style::Spheres] {
+        let m = molecule::scenes::generate(SceneName::Ns90k, Some(3000), 7);
+        let ms = ModelSettings {
+            style,
+            ..ModelSettings::default()
+        };
+        let bonds = BondSettings::default().build(&m).unwrap();
+        let model = ms.build_model(&m, &bonds).unwrap();
+        let s = scene::ball_sphere(&m, &ms);
+        for k in 0..3 {
+            assert!(
+                (s.center[k] - model.center[k]).abs() < 1e-3 * model.radius,
+                "{s:?} {:?}",
+                model.center
+            );
+        }
+        assert!(
+            (s.radius - model.radius).abs() < 1e-3 * model.radius,
+            "{s:?} {}",
+            model.radius
+        );
+    }
+}

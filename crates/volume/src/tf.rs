@@ -102,6 +102,9 @@ pub enum TfError {
         /// What was wrong.
         message: String,
     },
+    /// A `--tf` value that is neither a preset nor an existing file.
+    #[error("--tf {0:?}: neither a preset (coolwarm, viridis, grayscale) nor an existing file")]
+    Unknown(String),
     /// The file could not be read.
     #[error("{source_name}: {err}")]
     Io {
@@ -251,6 +254,19 @@ impl TransferFunction {
             });
         }
         Ok(TransferFunction::from_control_points(&points))
+    }
+
+    /// A preset by name (see [`Preset`]) or else a control-point file at `spec` (the `--tf`
+    /// flag).
+    pub fn from_spec(spec: &str) -> Result<TransferFunction, TfError> {
+        if let Ok(p) = spec.parse::<Preset>() {
+            return Ok(TransferFunction::preset(p));
+        }
+        let path = Path::new(spec);
+        if !path.exists() {
+            return Err(TfError::Unknown(spec.to_string()));
+        }
+        TransferFunction::load(path)
     }
 
     /// Reads and parses a transfer-function file.

@@ -1,0 +1,50 @@
+//! What a build made and what it took, one line per stage, for `-v` and progress logs.
+
+use crate::build::Scene;
+
+impl Scene {
+    /// One line per built stage (`bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
+    /// and the figures a user checks first (BVH nodes and SAH cost, lattice points, MB).
+    pub fn stage_report(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let t = &self.timings;
+        if let Some(model) = &self.model {
+            out.push(format!(
+                "bonds:   {:.3} s  {} bonds",
+                t.bonds,
+                self.bonds.len()
+            ));
+            let st = &model.bvh.stats;
+            out.push(format!(
+                "bvh:     {:.3} s  {} prims, {} nodes, SAH {:.1}, {:.1} MB ({:.1} B/atom), scene build {:.3} s",
+                st.build_time.as_secs_f64(),
+                st.prims,
+                st.nodes,
+                st.sah_cost,
+                st.bytes as f64 / 1e6,
+                st.bytes_per_atom(),
+                t.model
+            ));
+        }
+        if let (Some(d), Some(vs)) = (&self.volume, &self.settings.volume) {
+            out.push(format!(
+                "volume:  {:.3} s  {:?} lattice points at {} /Å, {:.1} MB {}",
+                t.volume + t.macrocells,
+                d.volume.grid.dims,
+                vs.voxels_per_angstrom,
+                d.volume.bytes() as f64 / 1e6,
+                d.volume.format().name()
+            ));
+        }
+        if let Some(lv) = &self.light_volume {
+            out.push(format!(
+                "light:   {:.3} s  light volume {:?} (every {} voxels), {:.1} MB",
+                t.light_volume,
+                lv.grid.dims,
+                lv.stride,
+                lv.bytes() as f64 / 1e6
+            ));
+        }
+        out
+    }
+}

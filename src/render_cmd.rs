@@ -96,7 +96,7 @@ pub enum ViewArg {
 pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Output PNG (default: <scene or file stem>.png).
+    /// Output PNG (default: the scene name or the file's stem, with .png).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Overwrite the output if it exists.
@@ -125,7 +125,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub volume: VolumeArgs,
     /// Transfer function: a preset (coolwarm, viridis, grayscale) or a file of control
-    /// points `value r g b a` (value in [0,1] of the density range).
+    /// points `value r g b a` (value from 0 to 1 over the density range).
     #[arg(long, default_value = "coolwarm")]
     pub tf: String,
     /// Volume: gradient lighting by central differences (headlight, or from --light-dir /

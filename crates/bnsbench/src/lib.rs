@@ -2,7 +2,7 @@
 //! al., UltraVis 2013, §5, Tables 1-3 and Figure 4) on this machine.
 //!
 //! Per scene: preprocess once (generate, bonds, BVH, density volume at the paper's
-//! resolution), then for every mode × view × size × thread count × ISA of the [`plan`] render
+//! resolution), then for every mode × view × size × thread count × ISA of the [`plan()`] render
 //! a warm-up frame and N timed frames ([`measure`]). [`report`] prints markdown tables with the
 //! paper's figures ([`paper`]) beside ours (whole machine and per core); [`json`] writes every
 //! measurement as JSON and reads earlier runs back.

@@ -8,6 +8,7 @@
 use spmd::{Simd, V3};
 
 use crate::geometry::PrimRecord;
+use crate::traverse::{PacketHit, RayPacket};
 
 /// `|a| · sign(b)` with `select` (there are no float bit ops in [`Simd`]).
 #[inline(always)]
@@ -147,47 +148,45 @@ pub fn ray_cylinder<S: Simd>(
     pick(s, tn, vn, tf, vf, tmin, tmax)
 }
 
-/// Leaf test (§4.3): intersects a packet with one primitive record (sphere, open cylinder, or capsule = cylinder
-/// with hemispherical caps when `capped`), narrowing `t` and recording `slot` where a lane hits nearer.
-/// Lanes off in `m` are untouched.
+/// Leaf test (§4.3): intersects the lanes `m` of `ray` with one primitive record (sphere, open
+/// cylinder, or capsule = cylinder with hemispherical caps when `capped`), narrowing `hit.t` and
+/// recording `slot` in `hit.slot` where a lane hits nearer. Lanes off in `m` are untouched.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub fn intersect_record<S: Simd>(
     s: S,
-    o: V3<S>,
-    d: V3<S>,
+    ray: &RayPacket<S>,
+    m: S::M,
     rec: &PrimRecord,
     capped: bool,
-    tmin: S::F32,
-    t: &mut S::F32,
-    slot_hit: &mut S::I32,
     slot: i32,
-    m: S::M,
+    hit: &mut PacketHit<S>,
 ) {
+    let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
     if rec.is_sphere() {
-        let (h, th) = ray_sphere(s, o, d, rec.p0, rec.r, tmin, *t);
-        let h = h & m;
-        *t = s.select(h, th, *t);
-        *slot_hit = s.select_i(h, s.splat_i(slot), *slot_hit);
+        let (h, th) = ray_sphere(s, o, d, rec.p0, rec.r, tmin, hit.t);
+        keep(s, h & m, th, slot, hit);
         return;
     }
     if rec.len > 0.0 {
-        let (h, th) = ray_cylinder(s, o, d, rec.p0, rec.axis, rec.len, rec.r, tmin, *t);
-        let h = h & m;
-        *t = s.select(h, th, *t);
-        *slot_hit = s.select_i(h, s.splat_i(slot), *slot_hit);
+        let (h, th) = ray_cylinder(s, o, d, rec.p0, rec.axis, rec.len, rec.r, tmin, hit.t);
+        keep(s, h & m, th, slot, hit);
     }
     if capped {
         let p1 = end_point(rec);
         // Degenerate sticks (no axis) are capped by a whole sphere: both halves.
         let ax = if rec.len > 0.0 { rec.axis } else { [0.0; 3] };
         for (c, side) in [(rec.p0, -1.0), (p1, 1.0)] {
-            let (h, th) = ray_cap(s, o, d, c, ax, side, rec.r, tmin, *t);
-            let h = h & m;
-            *t = s.select(h, th, *t);
-            *slot_hit = s.select_i(h, s.splat_i(slot), *slot_hit);
+            let (h, th) = ray_cap(s, o, d, c, ax, side, rec.r, tmin, hit.t);
+            keep(s, h & m, th, slot, hit);
         }
     }
+}
+
+/// Takes the nearer hit `th` in the lanes `h` as primitive `slot`.
+#[inline(always)]
+fn keep<S: Simd>(s: S, h: S::M, th: S::F32, slot: i32, hit: &mut PacketHit<S>) {
+    hit.t = s.select(h, th, hit.t);
+    hit.slot = s.select_i(h, s.splat_i(slot), hit.slot);
 }
 
 /// Second endpoint of a stick record (`p0 + axis·len`; `p0` for degenerate sticks).

@@ -14,10 +14,12 @@
 //! assert!((hit.t - 9.5).abs() < 1e-5);
 //! ```
 
+#![warn(missing_docs)]
 mod build;
 mod geometry;
 mod intersect;
 mod query;
+#[cfg(any(test, feature = "testing"))]
 pub mod scenes;
 mod traverse;
 mod tree;

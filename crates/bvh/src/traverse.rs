@@ -199,27 +199,18 @@ impl Bvh {
                             }
                             // One leaf test; any-hit starts from "no hit" and its epilog
                             // ends a hit lane (t = −∞ fails every box), closest keeps the nearest.
-                            let mut tt = hits[j].t;
-                            let mut slot = if ANY { s.splat_i(-1) } else { hits[j].slot };
-                            intersect_record(
-                                s,
-                                rays[j].o,
-                                rays[j].d,
-                                rec,
-                                capped,
-                                rays[j].tmin,
-                                &mut tt,
-                                &mut slot,
-                                (first + k) as i32,
-                                masks[j],
-                            );
+                            let mut h = PacketHit {
+                                t: hits[j].t,
+                                slot: if ANY { s.splat_i(-1) } else { hits[j].slot },
+                            };
+                            let slot = (first + k) as i32;
+                            intersect_record(s, &rays[j], masks[j], rec, capped, slot, &mut h);
                             if ANY {
-                                let hit = s.gt_i(slot, s.splat_i(-1));
-                                hits[j].slot = s.select_i(hit, slot, hits[j].slot);
+                                let hit = s.gt_i(h.slot, s.splat_i(-1));
+                                hits[j].slot = s.select_i(hit, h.slot, hits[j].slot);
                                 hits[j].t = s.select(hit, s.splat(f32::NEG_INFINITY), hits[j].t);
                             } else {
-                                hits[j].t = tt;
-                                hits[j].slot = slot;
+                                hits[j] = h;
                             }
                         }
                     }
@@ -281,24 +272,15 @@ impl Bvh {
 
     /// Nearest hits of a packet by testing every primitive (reference for tests; O(n)).
     #[inline(always)]
-    pub fn brute_packet<S: Simd>(&self, s: S, ray: &RayPacket<S>) -> PacketHit<S> {
-        let mut t = s.select(ray.active, ray.tmax, s.splat(f32::NEG_INFINITY));
-        let mut slot = s.splat_i(-1);
+    pub(crate) fn brute_packet<S: Simd>(&self, s: S, ray: &RayPacket<S>) -> PacketHit<S> {
+        let mut hit = PacketHit {
+            t: s.select(ray.active, ray.tmax, s.splat(f32::NEG_INFINITY)),
+            slot: s.splat_i(-1),
+        };
         for (k, rec) in self.records.iter().enumerate() {
-            intersect_record(
-                s,
-                ray.o,
-                ray.d,
-                rec,
-                self.capped,
-                ray.tmin,
-                &mut t,
-                &mut slot,
-                k as i32,
-                ray.active,
-            );
+            intersect_record(s, ray, ray.active, rec, self.capped, k as i32, &mut hit);
         }
-        PacketHit { t, slot }
+        hit
     }
 
     /// Single-ray traversal (the packet traversal on the scalar backend): for secondary or

@@ -11,7 +11,7 @@ use spmd::{Scalar, Simd, V3};
 
 use crate::geometry::{Aabb, Geometry};
 use crate::intersect::intersect_record;
-use crate::traverse::{slab_test, Ray, BOX_GROW};
+use crate::traverse::{slab_test, PacketHit, Ray, RayPacket, BOX_GROW};
 use crate::tree::Bvh;
 
 /// Children per wide node.
@@ -239,14 +239,22 @@ impl WideBvh {
         stack: &mut [WideEntry],
     ) -> (f32, i32) {
         assert_eq!(self.records, bvh.records.len(), "wide BVH of another tree");
-        let mut t = ray.tmax;
-        let mut slot = std::num::Wrapping(-1i32);
-        if self.nodes.is_empty() || t.is_nan() {
-            return (t, -1);
+        if self.nodes.is_empty() || ray.tmax.is_nan() {
+            return (ray.tmax, -1);
         }
         let records = &bvh.records[..];
-        let o1 = V3::<Scalar>::new(ray.o[0], ray.o[1], ray.o[2]);
-        let d1 = V3::<Scalar>::new(ray.d[0], ray.d[1], ray.d[2]);
+        // The leaf tests take the ray as a one-lane packet.
+        let ray1 = RayPacket::<Scalar> {
+            o: V3::new(ray.o[0], ray.o[1], ray.o[2]),
+            d: V3::new(ray.d[0], ray.d[1], ray.d[2]),
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+            active: true,
+        };
+        let mut hit = PacketHit::<Scalar> {
+            t: ray.tmax,
+            slot: std::num::Wrapping(-1),
+        };
         // The packet traversal's slab test, the ray uniform and the boxes varying.
         let o: V3<S> = V3::splat(s, ray.o);
         let inv: V3<S> = V3::new(
@@ -267,33 +275,23 @@ impl WideBvh {
         while sp > 0 {
             sp -= 1;
             let e = stack[sp];
-            if e.t > t {
+            if e.t > hit.t {
                 continue;
             }
             if e.count > 0 {
                 let first = e.child as usize;
                 for (k, rec) in records[first..first + e.count as usize].iter().enumerate() {
-                    intersect_record(
-                        Scalar,
-                        o1,
-                        d1,
-                        rec,
-                        bvh.capped,
-                        ray.tmin,
-                        &mut t,
-                        &mut slot,
-                        (first + k) as i32,
-                        true,
-                    );
-                    if ANY && slot.0 >= 0 {
-                        return (t, slot.0);
+                    let slot = (first + k) as i32;
+                    intersect_record(Scalar, &ray1, true, rec, bvh.capped, slot, &mut hit);
+                    if ANY && hit.slot.0 >= 0 {
+                        return (hit.t, hit.slot.0);
                     }
                 }
                 continue;
             }
             let node = &self.nodes[e.child as usize];
             let n = node.n as usize;
-            let tv = s.splat(t);
+            let tv = s.splat(hit.t);
             let mut nf = 0usize;
             let mut c = 0usize;
             while c < n {
@@ -338,7 +336,7 @@ impl WideBvh {
             stack[sp..sp + nf].copy_from_slice(&found[..nf]);
             sp += nf;
         }
-        (t, slot.0)
+        (hit.t, hit.slot.0)
     }
 
     /// Nearest hits of many rays, one at a time on `isa` (for tests and tools).

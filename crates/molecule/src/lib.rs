@@ -9,6 +9,7 @@
 //! Element data was generated from ASE's tables (see [`elements`]); the sample-file oracle is
 //! `tests/oracle/make_expected.py` (ASE 3.29).
 
+#![warn(missing_docs)]
 pub mod bonds;
 pub mod elements;
 pub mod read;

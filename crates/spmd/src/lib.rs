@@ -24,6 +24,7 @@
 //!   `i32::MIN` (x86's "integer indefinite").
 //! - Shifts by 32 or more give 0 (logical) or the sign fill (arithmetic).
 
+#![warn(missing_docs)]
 use core::fmt::Debug;
 use core::ops::{
     Add, AddAssign, BitAnd, BitOr, BitXor, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign,

@@ -93,3 +93,16 @@ pub fn near_cutoff(a: &Atoms, p: [f64; 3]) -> bool {
         (d2 / c - 1.0).abs() < 1e-4
     })
 }
+
+/// A coolwarm ramp whose opacity rises from 0 at value 0.2 to 0.25 at 0.9.
+pub fn ramp_tf() -> volume::TransferFunction {
+    // Colour varies with value so colour errors show; transparent below 0.2 (the Gaussian's
+    // cutoff, where Φ jumps, is at e^-2 ≈ 0.135 of the peak).
+    let mut tf = volume::TransferFunction::preset(volume::Preset::CoolWarm);
+    for (i, e) in tf.table.iter_mut().enumerate() {
+        let x = i as f32 / 255.0;
+        let t = ((x - 0.2) / 0.7).clamp(0.0, 1.0);
+        e[3] = 0.25 * t * t * (3.0 - 2.0 * t);
+    }
+    tf
+}

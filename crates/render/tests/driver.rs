@@ -1,0 +1,188 @@
+//! The driver's partial renders against the whole frame, bit for bit: the union of every rank's
+//! interleaved tiles and of row bands is the frame that one call renders, and a path-traced
+//! frame is its accumulation (what MPI ranks, giant-frame bands and the viewer rely on).
+
+use molecule::scenes::{generate, SceneName};
+use render::{
+    accumulate, render_frame, render_rows, render_tiles, Accum, Camera, FrameInputs, Framebuffer,
+    Material, Modality, RenderSettings, TileSet, View, DARK_BACKGROUND,
+};
+use scene::{Scene, SceneSettings, VolumeSettings};
+use spmd::Isa;
+use volume::{Lighting, MarchOptions};
+
+/// A small nanobowl with geometry and a coarse density volume.
+fn scene() -> Scene {
+    let m = generate(SceneName::Nanobowl, Some(400), 3);
+    let settings = SceneSettings {
+        volume: Some(VolumeSettings {
+            voxels_per_angstrom: 1.5,
+            ..VolumeSettings::default()
+        }),
+        ..SceneSettings::default()
+    };
+    Scene::build(Isa::detect(), &m, &settings).unwrap()
+}
+
+/// One setting per integrator: headlight b&s, lit vol+b&s, shadows, AO, path (3 spp).
+fn settings() -> Vec<(&'static str, RenderSettings, bool)> {
+    let lit = MarchOptions {
+        lighting: Lighting::Headlight,
+        ..MarchOptions::default()
+    };
+    let traced = |m| RenderSettings::traced(m, DARK_BACKGROUND);
+    vec![
+        ("bs", RenderSettings::default(), false),
+        (
+            "vol+bs lit",
+            RenderSettings {
+                march: lit,
+                ..RenderSettings::headlight(DARK_BACKGROUND)
+            },
+            true,
+        ),
+        ("shadows", traced(Modality::Direct { shadows: true }), false),
+        (
+            "ao",
+            traced(Modality::Ao {
+                samples: 3,
+                distance: 4.0,
+            }),
+            false,
+        ),
+        (
+            "path",
+            RenderSettings {
+                spp: 3,
+                ..traced(Modality::Path {
+                    material: Material::Diffuse,
+                    max_depth: 3,
+                    roughness: 0.0,
+                })
+            },
+            false,
+        ),
+    ]
+}
+
+// An odd size: partial tiles on the right and bottom edges.
+const W: u32 = 53;
+const H: u32 = 37;
+
+#[test]
+fn every_ranks_tiles_together_are_the_whole_frame() {
+    let sc = scene();
+    let model = sc.model.as_ref().unwrap();
+    let cam = Camera::view(
+        View::Far,
+        sc.sphere.center,
+        sc.sphere.radius,
+        45.0,
+        W as f32 / H as f32,
+    );
+    for isa in Isa::under_test() {
+        for (name, set, vol) in settings() {
+            let vs = sc.volume_scene(set.march).filter(|_| vol);
+            let inp = FrameInputs {
+                model: Some(model),
+                volume: vs.as_ref(),
+                camera: &cam,
+            };
+            let mut whole = Framebuffer::new(W, H, 0).unwrap();
+            render_frame(&inp, &set, &mut whole, isa).unwrap();
+            for ranks in [1, 2, 3, 7] {
+                // Every rank renders into the same buffer; each pixel is written by one rank.
+                let mut union = Framebuffer::new(W, H, 0x1234_5678).unwrap();
+                for rank in 0..ranks {
+                    render_tiles(
+                        &inp,
+                        &set,
+                        TileSet::Interleaved { rank, ranks },
+                        &mut union,
+                        isa,
+                    )
+                    .unwrap();
+                }
+                assert!(
+                    union == whole,
+                    "{isa} {name}: {ranks} ranks differ from one frame"
+                );
+            }
+            // A rank's own tiles alone leave the others untouched.
+            let mut one = Framebuffer::new(W, H, 7).unwrap();
+            render_tiles(
+                &inp,
+                &set,
+                TileSet::Interleaved { rank: 1, ranks: 2 },
+                &mut one,
+                isa,
+            )
+            .unwrap();
+            let untouched = one.pixels.iter().filter(|&&p| p == 7).count();
+            assert!(
+                untouched > 0 && untouched < one.pixels.len(),
+                "{isa} {name}"
+            );
+        }
+    }
+}
+
+#[test]
+fn row_bands_together_are_the_whole_frame() {
+    let sc = scene();
+    let model = sc.model.as_ref().unwrap();
+    let cam = Camera::view(
+        View::Close,
+        sc.sphere.center,
+        sc.sphere.radius,
+        45.0,
+        W as f32 / H as f32,
+    );
+    for isa in Isa::under_test() {
+        for (name, set, vol) in settings() {
+            let vs = sc.volume_scene(set.march).filter(|_| vol);
+            let inp = FrameInputs {
+                model: Some(model),
+                volume: vs.as_ref(),
+                camera: &cam,
+            };
+            let mut whole = Framebuffer::new(W, H, 0).unwrap();
+            render_frame(&inp, &set, &mut whole, isa).unwrap();
+            // Bands that start and end inside tiles, one a single row.
+            let mut rows = Vec::new();
+            for (a, b) in [(0, 5), (5, 6), (6, 20), (20, H)] {
+                let mut band = vec![0u32; ((b - a) * W) as usize];
+                render_rows(&inp, &set, W, H, a..b, &mut band, isa).unwrap();
+                rows.extend(band);
+            }
+            assert!(
+                rows == whole.pixels,
+                "{isa} {name}: bands differ from one frame"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_whole_path_traced_frame_is_its_accumulation_tone_mapped() {
+    // (How samples split between `accumulate` calls is tested in modalities.rs.)
+    let sc = scene();
+    let model = sc.model.as_ref().unwrap();
+    let cam = Camera::view(
+        View::Far,
+        sc.sphere.center,
+        sc.sphere.radius,
+        45.0,
+        W as f32 / H as f32,
+    );
+    let inp = FrameInputs::geometry(model, &cam);
+    for isa in Isa::under_test() {
+        for (name, set, _) in settings().into_iter().filter(|(_, s, _)| s.is_linear()) {
+            let mut acc = Accum::new(W, H).unwrap();
+            accumulate(&inp, &set, &mut acc, set.spp, isa).unwrap();
+            let mut fb = Framebuffer::new(W, H, 0).unwrap();
+            render_frame(&inp, &set, &mut fb, isa).unwrap();
+            assert!(fb == acc.to_framebuffer(true, set.exposure), "{isa} {name}");
+        }
+    }
+}

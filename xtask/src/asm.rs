@@ -37,6 +37,14 @@ pub enum Binary {
 impl Binary {
     const ALL: [Binary; 3] = [Binary::Bnsview, Binary::KernelsBench, Binary::VolumeBench];
 
+    /// Cargo's kind of the target.
+    fn kind(self) -> &'static str {
+        match self {
+            Binary::Bnsview => "bin",
+            Binary::KernelsBench | Binary::VolumeBench => "bench",
+        }
+    }
+
     /// Cargo target name.
     fn target(self) -> &'static str {
         match self {
@@ -175,23 +183,19 @@ fn functions(dump: &str) -> Vec<(&str, Vec<&str>)> {
 fn build() -> Result<Vec<(Binary, PathBuf)>> {
     let mut c = super::cargo();
     c.args([
+        // The whole workspace's binaries and benches: the same feature set as `cargo test
+        // --workspace` (dev-dependencies' features included), so the test build is reused.
         "build",
         "--release",
-        "-p",
-        "bnsview",
-        "-p",
-        "volume",
-        "--bin",
-        "bnsview",
+        "--workspace",
+        "--bins",
         "--bench",
-        "kernels",
-        "--bench",
-        "volume",
+        "*",
         "--message-format=json-render-diagnostics",
     ])
     // v0 mangling comes from .cargo/config.toml, which RUSTFLAGS would override.
     .env_remove("RUSTFLAGS");
-    eprintln!("xtask: cargo build --release (bnsview, kernels and volume benches), v0 mangling");
+    eprintln!("xtask: cargo build --release --workspace --bins --bench '*' (for the disassembly)");
     let out = c
         .stderr(std::process::Stdio::inherit())
         .output()
@@ -211,7 +215,12 @@ fn build() -> Result<Vec<(Binary, PathBuf)>> {
         else {
             continue;
         };
-        if let Some(b) = Binary::ALL.into_iter().find(|b| b.target() == name) {
+        // Only binaries and benches (a library's test harness has the crate's name too).
+        let kind_ok = |b: Binary| line.contains(&format!("\"kind\":[\"{}\"]", b.kind()));
+        if let Some(b) = Binary::ALL
+            .into_iter()
+            .find(|&b| b.target() == name && kind_ok(b))
+        {
             found.push((b, PathBuf::from(exe)));
         }
     }

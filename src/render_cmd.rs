@@ -96,7 +96,7 @@ pub enum ViewArg {
 pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Output PNG (default: the scene name or the file's stem, with .png).
+    /// Output image, .png or .jpg (default: the scene name or the file's stem, with .png).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Overwrite the output if it exists.
@@ -228,8 +228,13 @@ fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
 /// Run `bnsview render`.
 pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     if let Some(n) = args.threads {
+        // More threads than this per core only add overhead (and a stack each).
+        let cap = 16 * std::thread::available_parallelism().map_or(1, |c| c.get());
+        if n == 0 || n > cap {
+            bail!("--threads {n}: use 1 to {cap} (16 per core on this machine)");
+        }
         rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
+            .num_threads(n)
             .build_global()
             .context("--threads")?;
     }
@@ -249,6 +254,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         };
         PathBuf::from(format!("{stem}.png"))
     });
+    render::ImageFormat::from_path(&output)?;
     if output.exists() && !args.force {
         bail!("{} exists; pass --force to overwrite it", output.display());
     }
@@ -338,7 +344,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             String::new()
         }
     ));
-    fb.save_png(&output)
+    fb.save(&output)
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
         "wrote {} ({w}x{h}, {}{}{}, {isa})",

@@ -120,6 +120,53 @@ fn render_writes_a_png_of_the_scene_and_never_overwrites_unasked() {
 }
 
 #[test]
+fn the_output_format_follows_the_extension_and_threads_are_capped() {
+    let d = scratch("formats");
+    let args = [
+        "render", "--scene", "nanobowl", "--atoms", "2000", "--size", "64x48", "-o",
+    ];
+    let (png, jpg) = (d.join("a.png"), d.join("a.JPG"));
+    for out in [&png, &jpg] {
+        let (ok, _, err) = run(bnsview().args(args).arg(out));
+        assert!(ok, "{err}");
+    }
+    // A JPEG (its magic number, read back by the decoder) of the PNG's picture.
+    assert_eq!(std::fs::read(&jpg).unwrap()[..3], [0xFF, 0xD8, 0xFF]);
+    let a = image::open(&png).unwrap().to_rgb8();
+    let b = image::open(&jpg).unwrap().to_rgb8();
+    assert_eq!(b.dimensions(), (64, 48));
+    let diff: f64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| (*x as f64 - *y as f64).abs())
+        .sum::<f64>()
+        / a.as_raw().len() as f64;
+    assert!(diff < 6.0, "mean difference {diff} from the PNG");
+    // Any other extension is refused before the work, and nothing is written.
+    let bmp = d.join("a.bmp");
+    let (ok, _, err) = run(bnsview().args(args).arg(&bmp));
+    assert!(
+        !ok && err.contains("unknown image format") && err.contains(".jpg"),
+        "{err}"
+    );
+    assert!(!bmp.exists());
+    // Threads beyond 16 per core (a million would start a million) and zero are refused.
+    for n in ["1000000", "0"] {
+        let (ok, _, err) = run(bnsview()
+            .args(args)
+            .arg(d.join("t.png"))
+            .args(["--threads", n]));
+        assert!(
+            !ok && err.contains(&format!("--threads {n}: use 1 to")),
+            "{err}"
+        );
+    }
+    assert!(!d.join("t.png").exists());
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
 fn render_reports_bad_input_with_file_and_line() {
     let d = scratch("bad");
     let f = d.join("broken.xyz");

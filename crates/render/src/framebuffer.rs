@@ -1,11 +1,11 @@
-//! RGBA8 framebuffer and PNG output.
+//! RGBA8 framebuffer and its output as PNG or JPEG.
 
 use std::path::Path;
 
 /// Errors of image output.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// Writing the PNG failed.
+    /// Writing the image failed.
     #[error("writing {path}: {source}")]
     Png {
         /// The file.
@@ -13,9 +13,37 @@ pub enum RenderError {
         /// Why.
         source: image::ImageError,
     },
+    /// The file name asks for a format that is not written.
+    #[error("{0}: unknown image format; name the output .png or .jpg")]
+    UnknownFormat(String),
     /// The frame is too large for the PNG encoder or for memory.
     #[error("framebuffer {0}x{1} is too large")]
     TooLarge(u32, u32),
+}
+
+/// An image file format a frame is written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// PNG, 8-bit RGBA, lossless.
+    Png,
+    /// JPEG, 8-bit RGB at quality [`JPEG_QUALITY`] (alpha dropped).
+    Jpeg,
+}
+
+/// JPEG quality (1-100) of [`Framebuffer::save`].
+pub const JPEG_QUALITY: u8 = 95;
+
+impl ImageFormat {
+    /// The format `path`'s extension names (`.png`, `.jpg` or `.jpeg`, any case): check it
+    /// before rendering, so a long render is not lost to a typo.
+    pub fn from_path(path: &Path) -> Result<ImageFormat, RenderError> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        match ext.to_ascii_lowercase().as_str() {
+            "png" => Ok(ImageFormat::Png),
+            "jpg" | "jpeg" => Ok(ImageFormat::Jpeg),
+            _ => Err(RenderError::UnknownFormat(path.display().to_string())),
+        }
+    }
 }
 
 /// Row-major RGBA8 pixels, one packed `u32` each (`r | g << 8 | b << 16 | a << 24`, so the
@@ -63,7 +91,45 @@ impl Framebuffer {
         }
     }
 
-    /// Writes an 8-bit RGBA PNG.
+    /// Writes the frame in the format of `path`'s extension ([`ImageFormat::from_path`]).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
+        let path = path.as_ref();
+        match ImageFormat::from_path(path)? {
+            ImageFormat::Png => self.save_png(path),
+            ImageFormat::Jpeg => self.save_jpeg(path),
+        }
+    }
+
+    /// Writes an 8-bit RGB JPEG at [`JPEG_QUALITY`] (whatever the extension).
+    pub fn save_jpeg(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
+        use std::io::Write;
+        let path = path.as_ref();
+        let err = |source| RenderError::Png {
+            path: path.display().to_string(),
+            source,
+        };
+        let rgb: Vec<u8> = self
+            .pixels
+            .iter()
+            .flat_map(|p| {
+                let [r, g, b, _] = p.to_le_bytes();
+                [r, g, b]
+            })
+            .collect();
+        let file = std::fs::File::create(path).map_err(|e| err(e.into()))?;
+        let mut out = std::io::BufWriter::new(file);
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, JPEG_QUALITY)
+            .encode(
+                &rgb,
+                self.width,
+                self.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(err)?;
+        out.flush().map_err(|e| err(e.into()))
+    }
+
+    /// Writes an 8-bit RGBA PNG (whatever the extension).
     pub fn save_png(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
         let path = path.as_ref();
         let err = |source| RenderError::Png {

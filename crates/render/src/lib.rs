@@ -22,7 +22,7 @@ pub use ao_at::ambient_occlusion_at;
 pub use driver::{
     accumulate, render_frame, render_rows, render_tiles, FrameInputs, RenderStats, TileSet, TILE,
 };
-pub use framebuffer::{Framebuffer, RenderError};
+pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,

@@ -5,14 +5,23 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, ValueEnum};
 use molecule::scenes::SceneName;
 use spmd::Isa;
 
 use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel};
 
 use crate::pipeline::GeometryArgs;
-use crate::render_cmd::{parse_size, ViewArg};
+use crate::render_cmd::parse_size;
+
+/// Which of the paper's views (Table 3).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewArg {
+    /// The whole molecule fits in the frame.
+    Far,
+    /// A quarter of the far distance from the centre, the frame filled.
+    Close,
+}
 
 /// Arguments of `bnsview bench`. The ISA comes from the global `--isa` (`all` = every
 /// backend this CPU supports).

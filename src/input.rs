@@ -15,6 +15,7 @@ use scene::BondSource;
 
 /// Where the atoms come from and how they are bonded.
 #[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Input and bonds")]
 pub struct InputArgs {
     /// Molecule file (xyz, pdb, lammps dump/data, gro; optionally .gz).
     #[arg(conflicts_with = "scene")]

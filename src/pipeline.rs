@@ -8,6 +8,7 @@ use volume::VolumeFormat;
 
 /// Geometry options of the ball-and-stick scene.
 #[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Style and colour")]
 pub struct GeometryArgs {
     /// Drawing style.
     #[arg(long, value_enum, default_value_t = Style::BallAndStick)]
@@ -28,10 +29,37 @@ pub struct GeometryArgs {
     /// Colormap for `--color COLUMN`.
     #[arg(long, value_enum, default_value_t = Colormap::Viridis)]
     pub colormap: Colormap,
+    /// Values mapped to the colormap's ends for `--color COLUMN`, `LO:HI` (default: the
+    /// column's range in the frame, printed by -v).
+    #[arg(long, value_name = "LO:HI", value_parser = parse_range, allow_hyphen_values = true)]
+    pub color_range: Option<(f32, f32)>,
+    /// Draw a colour legend (the colormap, its range and the column) at the right edge of
+    /// the image, for `--color COLUMN`.
+    #[arg(long)]
+    pub legend: bool,
+    /// Draw the simulation cell (box) of the input as thin grey sticks.
+    #[arg(long)]
+    pub cell: bool,
+}
+
+/// `LO:HI`, two finite numbers with LO < HI.
+fn parse_range(s: &str) -> Result<(f32, f32), String> {
+    let bad = || format!("expected LO:HI, two finite numbers with LO < HI (e.g. -1:1), got {s:?}");
+    let (lo, hi) = s.split_once(':').ok_or_else(bad)?;
+    let (lo, hi): (f32, f32) = (
+        lo.trim().parse().map_err(|_| bad())?,
+        hi.trim().parse().map_err(|_| bad())?,
+    );
+    if lo.is_finite() && hi.is_finite() && lo < hi {
+        Ok((lo, hi))
+    } else {
+        Err(bad())
+    }
 }
 
 /// Volume options (the density grid).
 #[derive(Args, Debug, Clone)]
+#[command(next_help_heading = "Volume")]
 pub struct VolumeArgs {
     /// Density grid resolution (voxels per Å; the paper uses 4, and 1 for sio2 and anp3).
     #[arg(long, default_value_t = 4.0)]
@@ -44,12 +72,18 @@ pub struct VolumeArgs {
 impl GeometryArgs {
     /// The model settings of the flags (`wide_bvh` off: the caller knows the traversal).
     pub fn settings(&self) -> anyhow::Result<ModelSettings> {
+        if self.color == "element" && (self.color_range.is_some() || self.legend) {
+            anyhow::bail!(
+                "--color-range and --legend belong to colouring by a column: add --color COLUMN (e.g. --color q)"
+            );
+        }
         let color = if self.color == "element" {
             ColorBy::Element
         } else {
             ColorBy::Column {
                 name: self.color.clone(),
                 colormap: self.colormap,
+                range: self.color_range,
             }
         };
         Ok(ModelSettings {
@@ -59,6 +93,8 @@ impl GeometryArgs {
             stick_radius: self.stick_radius,
             color,
             wide_bvh: false,
+            periodic_bonds: false,
+            draw_cell: self.cell,
         })
     }
 }

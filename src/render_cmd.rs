@@ -5,10 +5,12 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use render::{
-    render_frame, Camera, FrameInputs, Framebuffer, Material, Modality, RenderSettings,
-    SecondaryTraversal, View, DARK_BACKGROUND, HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
+    draw_legend, render_frame, Camera, FrameInputs, Framebuffer, Legend, Material, Modality,
+    RenderSettings, SecondaryTraversal, DARK_BACKGROUND, HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
 };
-use scene::{LightVolumeSettings, Orbit, Scene, SceneSettings, LIGHT_VOLUME_STRIDE};
+use scene::{
+    ColorBy, LightVolumeSettings, Orbit, Scene, SceneSettings, ViewPreset, LIGHT_VOLUME_STRIDE,
+};
 use spmd::Isa;
 use volume::{Light, Lighting, MarchOptions, TransferFunction, VolumeShadows};
 
@@ -82,43 +84,41 @@ fn parse_point(s: &str) -> Result<[f32; 3], String> {
     vec3(s).ok_or_else(|| format!("{s:?}: expected a point x,y,z in Å (three finite numbers)"))
 }
 
-/// Which of the paper's views (Table 3).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ViewArg {
-    /// The whole molecule fits in the frame.
-    Far,
-    /// A quarter of the far distance from the centre, the frame filled.
-    Close,
-}
-
 /// Arguments of `bnsview render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// Output image, .png or .jpg (default: the scene name or the file's stem, with .png).
-    #[arg(short, long)]
+    #[arg(help_heading = "Output", short, long)]
     pub output: Option<PathBuf>,
     /// Overwrite the output if it exists.
-    #[arg(short, long)]
+    #[arg(help_heading = "Output", short, long)]
     pub force: bool,
     /// Image size, WIDTHxHEIGHT pixels.
-    #[arg(long, default_value = "1024x1024", value_parser = parse_size)]
+    #[arg(help_heading = "Output", long, default_value = "1024x1024", value_parser = parse_size)]
     pub size: (u32, u32),
     /// What to draw.
-    #[arg(long, value_enum, default_value_t = Mode::Bs)]
+    #[arg(help_heading = "Output", long, value_enum, default_value_t = Mode::Bs)]
     pub mode: Mode,
     /// Camera preset (ignored when --camera is given).
-    #[arg(long, value_enum, default_value_t = ViewArg::Far)]
-    pub view: ViewArg,
+    #[arg(help_heading = "Camera", long, value_enum, default_value_t = ViewPreset::Far)]
+    pub view: ViewPreset,
+    /// Orbit `AZ,EL` (degrees): the eye turned about +y by AZ and raised by EL around the
+    /// centre, instead of the preset's direction.
+    #[arg(help_heading = "Camera", long, allow_hyphen_values = true)]
+    pub orbit: Option<Orbit>,
+    /// Zoom factor of the preset's distance (2 = half as far).
+    #[arg(help_heading = "Camera", long, default_value_t = 1.0, value_parser = positive)]
+    pub zoom: f32,
     /// Explicit camera: `eye=x,y,z:at=x,y,z[:up=x,y,z][:fov=deg][:ortho=height_Å]`.
-    #[arg(long)]
+    #[arg(help_heading = "Camera", long)]
     pub camera: Option<String>,
     /// Vertical field of view of the presets (degrees).
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(help_heading = "Camera", long, default_value_t = 45.0)]
     pub fov: f32,
     /// Background colour `r,g,b` (0-255; default white for bs, near-black for volume modes).
-    #[arg(long, value_parser = parse_rgb)]
+    #[arg(help_heading = "Output", long, value_parser = parse_rgb)]
     pub background: Option<[u8; 3]>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
@@ -126,82 +126,82 @@ pub struct RenderArgs {
     pub volume: VolumeArgs,
     /// Transfer function: a preset (coolwarm, viridis, grayscale) or a file of control
     /// points `value r g b a` (value from 0 to 1 over the density range).
-    #[arg(long, default_value = "coolwarm")]
+    #[arg(help_heading = "Volume", long, default_value = "coolwarm")]
     pub tf: String,
     /// Volume: gradient lighting by central differences (headlight, or from --light-dir /
     /// --light-pos when given or when --volume-shadows is on).
-    #[arg(long)]
+    #[arg(help_heading = "Volume", long)]
     pub lit: bool,
     /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir or --light-pos with hard
     /// shadows.
-    #[arg(long, conflicts_with = "ao")]
+    #[arg(help_heading = "Lighting", long, conflicts_with = "ao")]
     pub shadows: bool,
     /// Ball-and-stick (bs, vol+bs): ambient occlusion with N cosine-distributed rays per hit.
-    #[arg(long, value_name = "N")]
+    #[arg(help_heading = "Lighting", long, value_name = "N")]
     pub ao: Option<u32>,
     /// Ambient occlusion distance (Å).
-    #[arg(long, default_value_t = 4.0, value_parser = positive)]
+    #[arg(help_heading = "Lighting", long, default_value_t = 4.0, value_parser = positive)]
     pub ao_distance: f32,
     /// Direction towards a directional light, world space `x,y,z` (default 1,2,1.5).
-    #[arg(long, value_parser = parse_dir, conflicts_with = "light_pos", allow_hyphen_values = true)]
+    #[arg(help_heading = "Lighting", long, value_parser = parse_dir, conflicts_with = "light_pos", allow_hyphen_values = true)]
     pub light_dir: Option<[f32; 3]>,
     /// Position of a point light instead, world space `x,y,z` in Å (no distance fall-off).
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    #[arg(help_heading = "Lighting", long, value_parser = parse_point, allow_hyphen_values = true)]
     pub light_pos: Option<[f32; 3]>,
     /// Light intensity (shadows: factor of max(0, n·l); path: irradiance / π).
-    #[arg(long, default_value_t = 0.85)]
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.85)]
     pub light_intensity: f32,
     /// Ambient term of --shadows shading.
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.2)]
     pub ambient: f32,
     /// The volume casts shadows (paper §4.5, Figure 4): with --mode volume every visible
     /// sample is shadowed by the density towards the light; with --mode vol+bs --shadows also
     /// the balls and sticks (soft shadows).
-    #[arg(long)]
+    #[arg(help_heading = "Volume", long)]
     pub volume_shadows: bool,
     /// Step of shadow rays through the volume (voxels).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(help_heading = "Volume", long, default_value_t = 2.0)]
     pub shadow_step: f32,
     /// Volumetric shadows: march a shadow ray from every shaded volume sample instead of
     /// looking up the light volume precomputed every 2 voxels (slower; the reference).
-    #[arg(long)]
+    #[arg(help_heading = "Volume", long)]
     pub shadow_rays: bool,
     /// Path tracing: BRDF of the atoms.
-    #[arg(long, value_enum, default_value_t = Material::Metal)]
+    #[arg(help_heading = "Path tracing", long, value_enum, default_value_t = Material::Metal)]
     pub material: Material,
     /// Path tracing: samples per pixel.
-    #[arg(long, default_value_t = 16)]
+    #[arg(help_heading = "Path tracing", long, default_value_t = 16)]
     pub spp: u32,
     /// Path tracing: maximum hits per path.
-    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(help_heading = "Path tracing", long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..))]
     pub max_depth: u32,
     /// Path tracing, metal: roughness (0 = mirror).
-    #[arg(long, default_value_t = 0.15, value_parser = non_negative)]
+    #[arg(help_heading = "Path tracing", long, default_value_t = 0.15, value_parser = non_negative)]
     pub roughness: f32,
     /// Path tracing: exposure (radiance multiplier before clamp and gamma 2).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(help_heading = "Path tracing", long, default_value_t = 1.0)]
     pub exposure: f32,
     /// Seed of the random numbers of AO and path tracing (`--seed` seeds scene generators).
-    #[arg(long, default_value_t = 1)]
+    #[arg(help_heading = "Path tracing", long, default_value_t = 1)]
     pub sample_seed: u32,
     /// Traversal of shadow and AO rays (and the path tracer's light samples): packets with
     /// any-hit exit, single rays, or single rays over the 8-wide BVH.
-    #[arg(long, value_enum, default_value_t = SecondaryTraversal::Packet)]
+    #[arg(help_heading = "Performance", long, value_enum, default_value_t = SecondaryTraversal::Packet)]
     pub secondary: SecondaryTraversal,
     /// Traversal of the path tracer's bounced rays (camera rays always go in packets).
-    #[arg(long, value_enum, default_value_t = SecondaryTraversal::Wide)]
+    #[arg(help_heading = "Path tracing", long, value_enum, default_value_t = SecondaryTraversal::Wide)]
     pub bounce_traversal: SecondaryTraversal,
     /// Volume: march every cell (no macrocell skipping), for comparison.
-    #[arg(long)]
+    #[arg(help_heading = "Volume", long)]
     pub no_macrocells: bool,
     /// Volume: post-classification instead of pre-integration, for comparison.
-    #[arg(long)]
+    #[arg(help_heading = "Volume", long)]
     pub no_preintegration: bool,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(help_heading = "Performance", long)]
     pub threads: Option<usize>,
     /// Print timings of every stage and the ISA to stderr.
-    #[arg(short, long)]
+    #[arg(help_heading = "Output", short, long)]
     pub verbose: bool,
 }
 
@@ -309,17 +309,16 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     // support, when there is no geometry).
     let camera = match &args.camera {
         Some(spec) => spec.parse::<Camera>()?,
-        None => Camera::fit(
-            match args.view {
-                ViewArg::Far => View::Far,
-                ViewArg::Close => View::Close,
-            },
-            sc.sphere,
-            args.fov,
-            w as f32 / h as f32,
-            Orbit::default(),
-        ),
+        None => {
+            let (view, mut orbit) = args.view.view_and_orbit();
+            if let Some(o) = args.orbit {
+                (orbit.azimuth_deg, orbit.elevation_deg) = (o.azimuth_deg, o.elevation_deg);
+            }
+            orbit.zoom = args.zoom;
+            Camera::fit(view, sc.sphere, args.fov, w as f32 / h as f32, orbit)
+        }
     };
+    verbose(format!("camera:  --camera {camera}"));
     let scene = sc.model.as_ref();
     let vscene = sc.volume_scene(march_options(&args));
     let settings = render_settings(&args);
@@ -330,12 +329,47 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     };
     let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
     let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
+    if let (Some(md), ColorBy::Column { name, colormap, .. }) = (
+        scene,
+        sc.settings
+            .model
+            .as_ref()
+            .map(|ms| &ms.color)
+            .unwrap_or(&ColorBy::Element),
+    ) {
+        if let Some((lo, hi)) = md.color_range {
+            verbose(format!(
+                "color:   {name} over --color-range {lo}:{hi} ({colormap:?})"
+            ));
+            if args.geometry.legend {
+                let legend = Legend {
+                    title: name.clone(),
+                    lo,
+                    hi,
+                    colormap: *colormap,
+                };
+                // Text in whichever of black and white stands out from the background.
+                let [r, g, b] = background(&args);
+                let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
+                let ink = if luma > 128.0 {
+                    [0, 0, 0]
+                } else {
+                    [255, 255, 255]
+                };
+                if draw_legend(&mut fb, &legend, ink).is_none() {
+                    eprintln!(
+                        "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
+                        render::MIN_LEGEND_FRAME
+                    );
+                }
+            }
+        }
+    }
     let (secs, spp) = (stats.time.as_secs_f64(), settings.frame_samples());
     verbose(format!(
-        "render:  {secs:.3} s  {w}x{h} {}{}{} ({:.1} Mrays/s, {:.2} fps{})",
+        "render:  {secs:.3} s  {w}x{h} {}{} ({:.1} Mrays/s, {:.2} fps{})",
         args.mode.name(),
-        modality_name(&args),
-        volume_suffix(&args),
+        settings.describe(),
         stats.mrays_per_s(),
         stats.fps(),
         if settings.is_linear() {
@@ -347,25 +381,12 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     fb.save(&output)
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
-        "wrote {} ({w}x{h}, {}{}{}, {isa})",
+        "wrote {} ({w}x{h}, {}{}, {isa})",
         output.display(),
         args.mode.name(),
-        modality_name(&args),
-        volume_suffix(&args)
+        settings.describe()
     );
     Ok(())
-}
-
-/// " lit", " volume-shadowed" or both: how the volume is shaded, for reports.
-fn volume_suffix(args: &RenderArgs) -> String {
-    let mut s = String::new();
-    if args.lit {
-        s.push_str(" lit");
-    }
-    if args.volume_shadows && args.mode == Mode::Volume {
-        s.push_str(" volume-shadowed");
-    }
-    s
 }
 
 /// What `render` builds for the flags: the model unless `--mode volume`, the volume with
@@ -380,6 +401,7 @@ fn scene_settings(
         None
     } else {
         let mut ms = args.geometry.settings()?;
+        ms.periodic_bonds = input.pbc;
         ms.wide_bvh = modality(args) != Modality::Headlight
             && (args.secondary == SecondaryTraversal::Wide
                 || (args.mode == Mode::Path && args.bounce_traversal == SecondaryTraversal::Wide));
@@ -506,20 +528,4 @@ pub(crate) fn modality(args: &RenderArgs) -> Modality {
         return Modality::Direct { shadows: true };
     }
     Modality::Headlight
-}
-
-/// Suffix naming the modality in reports.
-fn modality_name(args: &RenderArgs) -> String {
-    match modality(args) {
-        Modality::Path { material, .. } => format!(" {material:?}").to_lowercase(),
-        Modality::Ao { samples, distance } => format!(" ao {samples}x{distance}Å"),
-        Modality::Direct { .. } => {
-            if args.volume_shadows {
-                " shadows (volume-attenuated)".into()
-            } else {
-                " shadows".into()
-            }
-        }
-        Modality::Headlight => String::new(),
-    }
 }

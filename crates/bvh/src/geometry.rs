@@ -39,16 +39,22 @@ impl Balls {
     }
 }
 
-/// Bonds drawn as sticks: finite cylinders from the centre of atom `a[i]` to the centre of
-/// atom `b[i]`, each half coloured as its atom.
+/// Bonds drawn as sticks: finite cylinders between two endpoints, each half coloured as its
+/// endpoint. Endpoint `i < balls.len()` is atom `i`; endpoint `balls.len() + k` is the extra
+/// point `ends[k]` — the outer end of a half-stick drawn for a bond across a periodic boundary,
+/// or a corner of a drawn simulation cell (see [`Geometry::push_end`]).
 #[derive(Clone, Debug, Default)]
 pub struct Sticks {
-    /// First atom of each bond (index into [`Balls`]).
+    /// First endpoint of each stick (an atom, or an extra end).
     pub a: Vec<u32>,
-    /// Second atom of each bond.
+    /// Second endpoint of each stick.
     pub b: Vec<u32>,
     /// Cylinder radius (Å), the same for every stick.
     pub radius: f32,
+    /// Extra endpoints that are not atom centres (Å).
+    pub ends: Vec<[f32; 3]>,
+    /// Colour of each extra endpoint (packed RGBA8, as [`Balls::color`]).
+    pub end_color: Vec<u32>,
 }
 
 impl Sticks {
@@ -235,10 +241,46 @@ impl Geometry {
                 a,
                 b,
                 radius: stick_radius,
+                ends: Vec::new(),
+                end_color: Vec::new(),
             },
             show_balls: true,
             capped: false,
         }
+    }
+
+    /// Position (Å) of stick endpoint `i`: atom `i`, or extra end `i - balls.len()`; NaN for
+    /// an index that names neither (such a stick is never hit).
+    #[inline]
+    pub fn endpoint(&self, i: u32) -> [f32; 3] {
+        let n = self.balls.len();
+        match (i as usize).checked_sub(n) {
+            None => self.balls.center(i as usize),
+            Some(k) => self.sticks.ends.get(k).copied().unwrap_or([f32::NAN; 3]),
+        }
+    }
+
+    /// Colour (packed RGBA8) of stick endpoint `i`, `None` where none was given.
+    pub fn endpoint_color(&self, i: u32) -> Option<u32> {
+        let n = self.balls.len();
+        match (i as usize).checked_sub(n) {
+            None => self.balls.color.get(i as usize).copied(),
+            Some(k) => self.sticks.end_color.get(k).copied(),
+        }
+    }
+
+    /// Adds an extra stick endpoint at `p` (Å) coloured `color` and returns its endpoint
+    /// index. Add all atoms first: the index counts from `balls.len()`.
+    pub fn push_end(&mut self, p: [f32; 3], color: u32) -> u32 {
+        self.sticks.ends.push(p);
+        self.sticks.end_color.push(color);
+        (self.balls.len() + self.sticks.ends.len() - 1) as u32
+    }
+
+    /// Adds a stick between endpoints `a` and `b` (atoms or extra ends).
+    pub fn push_stick(&mut self, a: u32, b: u32) {
+        self.sticks.a.push(a);
+        self.sticks.b.push(b);
     }
 
     /// Number of ball primitives (0 in licorice style).
@@ -280,8 +322,8 @@ impl Geometry {
             }
             Prim::Stick(j) => {
                 let j = j as usize;
-                let p0 = self.balls.center(self.sticks.a[j] as usize);
-                let p1 = self.balls.center(self.sticks.b[j] as usize);
+                let p0 = self.endpoint(self.sticks.a[j]);
+                let p1 = self.endpoint(self.sticks.b[j]);
                 // Axis in f64 so the unit vector is as exact as f32 allows.
                 let d = [
                     p1[0] as f64 - p0[0] as f64,
@@ -322,8 +364,8 @@ impl Geometry {
                 (c, c, self.balls.radius[i as usize])
             }
             Prim::Stick(j) => (
-                self.balls.center(self.sticks.a[j as usize] as usize),
-                self.balls.center(self.sticks.b[j as usize] as usize),
+                self.endpoint(self.sticks.a[j as usize]),
+                self.endpoint(self.sticks.b[j as usize]),
                 self.sticks.radius,
             ),
         };

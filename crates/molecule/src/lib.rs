@@ -108,6 +108,41 @@ impl Cell {
     }
 }
 
+/// The minimum-image convention of a cell, with its inverse computed once: a displacement's
+/// fractional components along the periodic directions are rounded to the nearest lattice
+/// vector and taken off (the rule [`bonds`] measures bond lengths with).
+#[derive(Clone, Copy, Debug)]
+pub struct MinimumImage {
+    h: [[f64; 3]; 3],
+    inv: [[f64; 3]; 3],
+    periodic: [bool; 3],
+}
+
+impl MinimumImage {
+    /// The convention of `cell`; `None` if the cell is degenerate.
+    pub fn new(cell: &Cell) -> Option<MinimumImage> {
+        Some(MinimumImage {
+            h: cell.matrix(),
+            inv: cell.inverse()?,
+            periodic: cell.pbc,
+        })
+    }
+
+    /// The nearest periodic image of displacement `d` (Å).
+    pub fn apply(&self, d: [f64; 3]) -> [f64; 3] {
+        let mul = |m: &[[f64; 3]; 3], v: [f64; 3]| {
+            [0, 1, 2].map(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
+        };
+        let mut f = mul(&self.inv, d);
+        for (fk, &per) in f.iter_mut().zip(&self.periodic) {
+            if per {
+                *fk -= fk.round();
+            }
+        }
+        mul(&self.h, f)
+    }
+}
+
 /// One frame of atoms. Positions in Å, structure-of-arrays.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Molecule {

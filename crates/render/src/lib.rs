@@ -14,6 +14,7 @@ mod camera_rays;
 mod driver;
 mod framebuffer;
 mod integrator;
+mod legend;
 mod rng;
 mod settings;
 
@@ -24,6 +25,7 @@ pub use driver::{
 };
 pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};
+pub use legend::{draw_legend, legend_label, Legend, LegendBox, MIN_LEGEND_FRAME};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };

@@ -240,6 +240,27 @@ impl RenderSettings {
         matches!(self.modality, Modality::Path { .. })
     }
 
+    /// What the settings shade, for reports: `" lit"`, `" ao 4x4Å"`, `" shadows"`,
+    /// `" metal"`, `" volume-shadowed"`… (empty for the plain headlight modes).
+    pub fn describe(&self) -> String {
+        let mut s = match self.modality {
+            Modality::Headlight => String::new(),
+            Modality::Direct { .. } if self.volume_shadows && self.march.shadows.is_some() => {
+                " shadows (volume-attenuated)".into()
+            }
+            Modality::Direct { .. } => " shadows".into(),
+            Modality::Ao { samples, distance } => format!(" ao {samples}x{distance}Å"),
+            Modality::Path { material, .. } => format!(" {material:?}").to_lowercase(),
+        };
+        if self.march.lighting != Lighting::Unlit {
+            s.push_str(" lit");
+        }
+        if self.modality == Modality::Headlight && self.march.shadows.is_some() {
+            s.push_str(" volume-shadowed");
+        }
+        s
+    }
+
     /// Whether these settings use the wide BVH (so it is built before the tiles start).
     pub fn uses_wide(&self) -> bool {
         let wide = SecondaryTraversal::Wide;

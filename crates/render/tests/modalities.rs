@@ -44,6 +44,7 @@ fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Model {
             a: vec![],
             b: vec![],
             radius: 0.1,
+            ..Sticks::default()
         },
         show_balls: true,
         capped: false,

@@ -100,6 +100,7 @@ fn sphere_and_cylinder() -> Model {
             a: vec![1],
             b: vec![2],
             radius: 0.5,
+            ..Sticks::default()
         },
         show_balls: true,
         capped: false,

@@ -282,7 +282,16 @@ pub(crate) fn build_model(
     }));
     let coloring = match &ms.color {
         ColorBy::Element => Coloring::PerAtom,
-        ColorBy::Column { name, colormap } => {
+        ColorBy::Column {
+            name,
+            colormap,
+            range,
+        } => {
+            if let Some((lo, hi)) = *range {
+                if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                    return Err(SceneError::BadColorRange { lo, hi });
+                }
+            }
             let values = m.scalar(name).ok_or_else(|| SceneError::NoSuchColumn {
                 name: name.clone(),
                 available: m.scalars.iter().map(|(n, _)| n.clone()).collect(),
@@ -290,7 +299,7 @@ pub(crate) fn build_model(
             Coloring::Scalar {
                 values: values.to_vec(),
                 colormap: *colormap,
-                range: None,
+                range: *range,
             }
         }
     };
@@ -299,7 +308,13 @@ pub(crate) fn build_model(
         stick_radius: ms.stick_radius,
         style: ms.style,
         coloring,
+        cell: m.cell,
+        periodic_bonds: ms.periodic_bonds,
+        draw_cell: ms.draw_cell,
     };
+    if ms.draw_cell && m.cell.is_none() {
+        return Err(SceneError::NoCell);
+    }
     Ok(Model::new(&m.x, &m.y, &m.z, radius, colors, bonds, &opt))
 }
 

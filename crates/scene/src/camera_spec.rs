@@ -3,7 +3,8 @@
 
 use std::str::FromStr;
 
-use crate::camera::Camera;
+use crate::camera::{Camera, Projection};
+use crate::fit::Orbit;
 
 /// Why a camera spec was refused (messages name the `--camera` flag and the key).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -27,6 +28,9 @@ pub enum CameraSpecError {
     /// `eye` or `at` is missing.
     #[error("--camera needs {0}=x,y,z")]
     Missing(&'static str),
+    /// An `--orbit` that is not `AZ,EL` with the elevation within ±90°.
+    #[error("--orbit {0}: expected AZ,EL in degrees, EL from -90 to 90")]
+    BadOrbit(String),
     /// `eye` and `at` coincide, so there is no viewing direction.
     #[error("--camera: eye and at are the same point")]
     NoDirection,
@@ -105,6 +109,38 @@ impl FromStr for Camera {
     }
 }
 
+impl FromStr for Orbit {
+    type Err = CameraSpecError;
+
+    /// `AZ,EL` (degrees; see [`Orbit`]) with zoom 1.
+    fn from_str(s: &str) -> Result<Orbit, CameraSpecError> {
+        let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
+        match v.as_slice() {
+            [Some(az), Some(el)] if az.is_finite() && el.abs() <= 90.0 => Ok(Orbit {
+                azimuth_deg: *az,
+                elevation_deg: *el,
+                zoom: 1.0,
+            }),
+            _ => Err(CameraSpecError::BadOrbit(s.to_string())),
+        }
+    }
+}
+
+impl std::fmt::Display for Camera {
+    /// The `--camera` spec of this camera (`at` one unit along the view direction), which
+    /// [`Camera::from_str`] reads back to the same camera up to rounding.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // (`+ 0.0` prints −0 as 0.)
+        let v = |a: [f32; 3]| format!("{},{},{}", a[0] + 0.0, a[1] + 0.0, a[2] + 0.0);
+        let at = core::array::from_fn(|k| self.eye[k] + self.forward[k]);
+        write!(f, "eye={}:at={}:up={}", v(self.eye), v(at), v(self.up))?;
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => write!(f, ":fov={fov_y_deg}"),
+            Projection::Orthographic { height } => write!(f, ":ortho={height}"),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,6 +157,24 @@ mod tests {
             c,
             Camera::orthographic([1.0, 2.0, 3.0], [0.0; 3], [0.0, 0.0, 1.0], 12.5)
         );
+    }
+
+    #[test]
+    fn a_camera_prints_as_the_spec_that_makes_it() {
+        let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-5);
+        for c in [
+            Camera::look_at([3.0, -2.0, 40.5], [1.0, 0.5, -2.0], [0.0, 1.0, 0.0], 37.5),
+            Camera::orthographic([0.0, 30.0, 22.0], [0.0; 3], [0.0, 1.0, 0.0], 22.0),
+            Camera::look_at([0.0, 50.0, 0.0], [0.0; 3], [0.0, 0.0, -1.0], 45.0),
+        ] {
+            let back: Camera = c.to_string().parse().unwrap();
+            assert!(
+                close(back.eye, c.eye) && close(back.forward, c.forward),
+                "{c}"
+            );
+            assert!(close(back.right, c.right) && close(back.up, c.up), "{c}");
+            assert_eq!(back.projection, c.projection);
+        }
     }
 
     #[test]

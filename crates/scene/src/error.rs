@@ -22,6 +22,17 @@ pub enum SceneError {
         /// Columns the input has.
         available: Vec<String>,
     },
+    /// A colour range that is empty, reversed or not finite.
+    #[error("--color-range {lo}:{hi}: expected two finite values LO:HI with LO < HI")]
+    BadColorRange {
+        /// Low end given.
+        lo: f32,
+        /// High end given.
+        hi: f32,
+    },
+    /// Drawing the cell of an input that has none.
+    #[error("--cell: the input has no simulation cell (box) to draw")]
+    NoCell,
     /// [`crate::BondSource::File`] but the input lists no bonds.
     #[error("--bonds file: the input lists no bonds (LAMMPS data Bonds / PDB CONECT)")]
     NoFileBonds,

@@ -109,6 +109,40 @@ impl Default for Orbit {
     }
 }
 
+/// The named views of `--view`: the paper's far and close (looking along −z), and the far
+/// view from the front (+z), the side (+x) or the top (+y).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum ViewPreset {
+    /// The whole molecule in the frame, seen from +z (the paper's far view).
+    Far,
+    /// A quarter of the far distance from the centre, the frame filled (the paper's close view).
+    Close,
+    /// As far, from +z (x to the right, y up).
+    Front,
+    /// As far, from +x (−z to the right, y up).
+    Side,
+    /// As far, from +y, looking down (x to the right, −z up).
+    Top,
+}
+
+impl ViewPreset {
+    /// The distance and the orbit of the preset (zoom 1).
+    pub fn view_and_orbit(self) -> (View, Orbit) {
+        let orbit = |azimuth_deg, elevation_deg| Orbit {
+            azimuth_deg,
+            elevation_deg,
+            zoom: 1.0,
+        };
+        match self {
+            ViewPreset::Far | ViewPreset::Front => (View::Far, Orbit::default()),
+            ViewPreset::Close => (View::Close, Orbit::default()),
+            ViewPreset::Side => (View::Far, orbit(90.0, 0.0)),
+            ViewPreset::Top => (View::Far, orbit(0.0, 90.0)),
+        }
+    }
+}
+
 impl Camera {
     /// Fits a perspective camera to `sphere`: the [`View`] distance ([`Camera::view`]) divided
     /// by `orbit.zoom`, from direction (azimuth, elevation) around the centre, vertical field
@@ -185,6 +219,30 @@ mod tests {
         assert!(close(c.eye, [0.0, d / 2.0, 0.0]), "{:?}", c.eye);
         assert!(close(c.forward, [0.0, -1.0, 0.0]));
         assert!(close(c.up, [0.0, 0.0, -1.0]), "{:?}", c.up);
+    }
+
+    #[test]
+    fn presets_look_from_their_side() {
+        let s = Sphere {
+            center: [1.0, 2.0, 3.0],
+            radius: 10.0,
+        };
+        let cam = |p: ViewPreset| {
+            let (v, o) = p.view_and_orbit();
+            Camera::fit(v, s, 45.0, 1.0, o)
+        };
+        assert_eq!(cam(ViewPreset::Front), cam(ViewPreset::Far));
+        assert!(close(cam(ViewPreset::Side).forward, [-1.0, 0.0, 0.0]));
+        assert!(close(cam(ViewPreset::Top).forward, [0.0, -1.0, 0.0]));
+        assert!(close(cam(ViewPreset::Top).right, [1.0, 0.0, 0.0]));
+        for p in [ViewPreset::Side, ViewPreset::Top] {
+            let d = |c: Camera| {
+                (0..3)
+                    .map(|k| (c.eye[k] - s.center[k]).powi(2))
+                    .sum::<f32>()
+            };
+            assert!((d(cam(p)) - d(cam(ViewPreset::Far))).abs() < 1e-2, "{p:?}");
+        }
     }
 
     #[test]

@@ -15,6 +15,7 @@ mod error;
 mod fit;
 mod memory;
 mod model;
+mod periodic;
 mod report;
 mod settings;
 
@@ -23,9 +24,10 @@ pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
 pub use error::SceneError;
-pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ATOM_SPHERE_PAD};
+pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD};
 pub use memory::{MemoryEstimate, BVH_NODES_PER_PRIM, WIDE_NODES_PER_PRIM};
-pub use model::{Coloring, Model, ModelOptions, Style};
+pub use model::{Coloring, Model, ModelOptions, Style, CELL_COLOR};
+pub use periodic::{add_cell_edges, split_periodic_sticks};
 pub use settings::{
     BondSettings, BondSource, ColorBy, LightVolumeSettings, ModelSettings, RadiusKind,
     SceneSettings, VolumeSettings, LIGHT_VOLUME_STRIDE,

@@ -5,7 +5,13 @@ use std::sync::OnceLock;
 use bvh::{Bvh, Geometry, Prim, WideBvh};
 use rayon::prelude::*;
 
+use molecule::Cell;
+
 use crate::colormap::Colormap;
+use crate::periodic::{add_cell_edges, split_periodic_sticks};
+
+/// Colour of the drawn simulation cell's edges: a mid grey, seen on white and dark backgrounds.
+pub const CELL_COLOR: u32 = crate::rgba(128, 128, 128, 255);
 
 /// How the molecule is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +53,13 @@ pub struct ModelOptions {
     pub style: Style,
     /// Colouring.
     pub coloring: Coloring,
+    /// The simulation cell, used by `periodic_bonds` and `draw_cell`.
+    pub cell: Option<Cell>,
+    /// Draw bonds that cross the cell's periodic boundary as two half-sticks
+    /// ([`split_periodic_sticks`]).
+    pub periodic_bonds: bool,
+    /// Draw the cell's edges as sticks of [`CELL_COLOR`] ([`add_cell_edges`]).
+    pub draw_cell: bool,
 }
 
 impl Default for ModelOptions {
@@ -56,6 +69,9 @@ impl Default for ModelOptions {
             stick_radius: 0.15,
             style: Style::BallAndStick,
             coloring: Coloring::PerAtom,
+            cell: None,
+            periodic_bonds: false,
+            draw_cell: false,
         }
     }
 }
@@ -75,6 +91,9 @@ pub struct Model {
     pub center: [f32; 3],
     /// Radius of the bounding sphere (Å), including ball radii.
     pub radius: f32,
+    /// The values mapped to the colormap's ends when coloured by a scalar (Å-free: the
+    /// column's units); `None` for per-atom colours.
+    pub color_range: Option<(f32, f32)>,
     /// The 8-wide BVH for single incoherent rays, collapsed from `bvh` on first use.
     wide: OnceLock<WideBvh>,
 }
@@ -96,6 +115,7 @@ impl Model {
     ) -> Model {
         let n = x.len();
         let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
+        let mut color_range = None;
         let colors: Vec<u32> = match &opt.coloring {
             Coloring::PerAtom => {
                 if colors.len() == n {
@@ -117,6 +137,7 @@ impl Model {
                             (a.min(v), b.max(v))
                         })
                 });
+                color_range = Some((lo, hi));
                 let span = if hi > lo { hi - lo } else { 1.0 };
                 (0..n)
                     .map(|i| {
@@ -135,18 +156,25 @@ impl Model {
         let mut g = Geometry::from_atoms(x, y, z, &radii, &colors, bonds, opt.stick_radius);
         g.show_balls = opt.style != Style::Licorice;
         g.capped = opt.style == Style::Licorice;
-        Model::from_geometry(g)
+        if let Some(cell) = &opt.cell {
+            if opt.periodic_bonds {
+                split_periodic_sticks(&mut g, cell);
+            }
+            if opt.draw_cell {
+                add_cell_edges(&mut g, cell, CELL_COLOR);
+            }
+        }
+        let mut m = Model::from_geometry(g);
+        m.color_range = color_range;
+        m
     }
 
     /// Builds the BVH and colour tables for ready-made geometry (colours from
     /// `g.balls.color`, grey where missing).
     pub fn from_geometry(g: Geometry) -> Model {
         let bvh = Bvh::build(&g);
-        let color = |atom: u32| -> i32 {
-            g.balls
-                .color
-                .get(atom as usize)
-                .copied()
+        let color = |end: u32| -> i32 {
+            g.endpoint_color(end)
                 .unwrap_or(crate::rgba(200, 200, 200, 255)) as i32
         };
         let (slot_color_a, slot_color_b): (Vec<i32>, Vec<i32>) = bvh
@@ -187,8 +215,18 @@ impl Model {
                         0.0
                     }
                 })
-                .reduce(|| 0.0, f64::max) as f32;
-            (c, r.max(1e-3))
+                .reduce(|| 0.0, f64::max);
+            // Extra stick ends (half-sticks, cell corners) count with the stick radius.
+            let r_ends = g.sticks.ends.iter().fold(0.0f64, |acc, p| {
+                let d2: f64 = (0..3).map(|k| ((p[k] - c[k]) as f64).powi(2)).sum();
+                let v = d2.sqrt() + extra as f64;
+                if v.is_finite() {
+                    acc.max(v)
+                } else {
+                    acc
+                }
+            });
+            (c, (r.max(r_ends) as f32).max(1e-3))
         };
         Model {
             geometry: g,
@@ -197,6 +235,7 @@ impl Model {
             slot_color_b,
             center,
             radius,
+            color_range: None,
             wide: OnceLock::new(),
         }
     }

@@ -24,12 +24,15 @@ pub enum ColorBy {
     /// CPK/Jmol colour of the element.
     #[default]
     Element,
-    /// A per-atom column of the input (e.g. `q`) through a colormap over its finite range.
+    /// A per-atom column of the input (e.g. `q`) through a colormap.
     Column {
         /// Column name ([`molecule::Molecule::scalar`]).
         name: String,
         /// Colormap.
         colormap: Colormap,
+        /// Values mapped to the colormap's ends, `lo < hi` (`None`: the column's finite
+        /// minimum and maximum in this frame; the range used is [`crate::Model::color_range`]).
+        range: Option<(f32, f32)>,
     },
 }
 
@@ -49,6 +52,13 @@ pub struct ModelSettings {
     /// The 8-wide BVH will be used (secondary or bounce rays `Wide`): counted by
     /// [`crate::MemoryEstimate`] and built by [`crate::Scene::build`].
     pub wide_bvh: bool,
+    /// Draw a bond that crosses the periodic boundary of the input's cell as two half-sticks
+    /// at the two sides of the cell (the CLI's `--pbc`); off, or without a cell, a bond is
+    /// drawn between the two atoms as they are.
+    pub periodic_bonds: bool,
+    /// Draw the simulation cell's edges as sticks ([`crate::CELL_COLOR`]); an error when the
+    /// input has no cell.
+    pub draw_cell: bool,
 }
 
 impl Default for ModelSettings {
@@ -60,6 +70,8 @@ impl Default for ModelSettings {
             stick_radius: 0.15,
             color: ColorBy::Element,
             wide_bvh: false,
+            periodic_bonds: false,
+            draw_cell: false,
         }
     }
 }

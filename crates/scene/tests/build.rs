@@ -172,6 +172,7 @@ fn bad_settings_are_errors() {
     st.model.as_mut().unwrap().color = ColorBy::Column {
         name: "nope".into(),
         colormap: scene::Colormap::Viridis,
+        range: None,
     };
     let e = Scene::build(Isa::Scalar, &m, &st).unwrap_err();
     assert!(e.to_string().contains("--color nope"), "{e}");

@@ -115,6 +115,26 @@ impl InputArgs {
         })
     }
 
+    /// The reader options of the flags.
+    pub fn read_options(&self) -> anyhow::Result<ReadOptions> {
+        Ok(ReadOptions {
+            format: self.format,
+            types: match &self.types {
+                Some(s) => ReadOptions::parse_types(s).map_err(anyhow::Error::msg)?,
+                None => Vec::new(),
+            },
+            atom_style: self.atom_style.clone(),
+        })
+    }
+
+    /// Opens `path` as a trajectory with the flags' reader options.
+    pub fn open_trajectory(
+        &self,
+        path: &std::path::Path,
+    ) -> anyhow::Result<molecule::read::Trajectory> {
+        Ok(open(path, &self.read_options()?)?)
+    }
+
     /// Reads (or generates) the frame and builds its bonds; `count_frames` also scans the
     /// whole file for the number of frames.
     pub fn load(&self, count_frames: bool) -> anyhow::Result<Loaded> {
@@ -156,14 +176,7 @@ impl InputArgs {
                 .file
                 .clone()
                 .context("no input: give a FILE or --scene NAME")?;
-            let opts = ReadOptions {
-                format: self.format,
-                types: match &self.types {
-                    Some(s) => ReadOptions::parse_types(s).map_err(anyhow::Error::msg)?,
-                    None => Vec::new(),
-                },
-                atom_style: self.atom_style.clone(),
-            };
+            let opts = self.read_options()?;
             let bytes = std::fs::metadata(&path).map(|m| m.len()).ok();
             pb.set_message(format!("reading {}", path.display()));
             let mut t = open(&path, &opts)?;

@@ -11,6 +11,7 @@ mod input;
 mod isa_cmd;
 mod pipeline;
 mod render_cmd;
+mod series_cmd;
 
 /// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,
 /// with SIMD kernels compiled for SSE4.1, AVX2 and AVX-512 and chosen at run time.

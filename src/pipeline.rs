@@ -67,6 +67,10 @@ pub struct VolumeArgs {
     /// Voxel storage: u8 (quantised, one global scale) or f32.
     #[arg(long, default_value = "u8")]
     pub volume_format: String,
+    /// Density mapped to the top of the transfer function (default: the frame's maximum,
+    /// printed by -v with --frames).
+    #[arg(long)]
+    pub density_max: Option<f32>,
 }
 
 impl GeometryArgs {
@@ -109,6 +113,7 @@ impl VolumeArgs {
         Ok(VolumeSettings {
             voxels_per_angstrom: self.voxels_per_angstrom,
             format,
+            density_max: self.density_max,
             ..VolumeSettings::default()
         })
     }

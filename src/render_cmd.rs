@@ -90,8 +90,27 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// Output image, .png or .jpg (default: the scene name or the file's stem, with .png).
+    /// With --frames: a numbered name such as out_%05d.png (%d or %0Nd is the frame index in
+    /// the file; the default is STEM_%05d.png) or an animated .gif.
     #[arg(help_heading = "Output", short, long)]
     pub output: Option<PathBuf>,
+    /// Render frames of a trajectory, `all` or `A:B[:STEP]` (A up to but not including B,
+    /// every STEP-th), in one pass through the file, the next frame built while this one
+    /// renders. The camera and the colour and density ranges are fixed by the first frame.
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_name = "all|A:B[:STEP]",
+        conflicts_with = "frame"
+    )]
+    pub frames: Option<series::FrameRange>,
+    /// With --frames: build each frame after the previous one is rendered instead of in the
+    /// background (for comparison).
+    #[arg(help_heading = "Output", long, requires = "frames")]
+    pub no_pipeline: bool,
+    /// With --frames -o movie.gif: frames per second of the GIF.
+    #[arg(help_heading = "Output", long, default_value_t = series::DEFAULT_GIF_FPS, requires = "frames")]
+    pub gif_fps: f32,
     /// Overwrite the output if it exists.
     #[arg(help_heading = "Output", short, long)]
     pub force: bool,
@@ -243,6 +262,9 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     if input.file.is_none() && input.scene.is_none() {
         input.scene = Some(molecule::scenes::SceneName::Nanobowl);
     }
+    if args.frames.is_some() {
+        return crate::series_cmd::run(&args, &input, isa);
+    }
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = match (&input.file, input.scene) {
             (Some(f), _) => f
@@ -328,7 +350,9 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         camera: &camera,
     };
     let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
+    let pb = crate::input::spinner(&format!("rendering {w}x{h} {}", args.mode.name()));
     let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
+    pb.finish_and_clear();
     if let (Some(md), ColorBy::Column { name, colormap, .. }) = (
         scene,
         sc.settings
@@ -392,7 +416,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
 /// What `render` builds for the flags: the model unless `--mode volume`, the volume with
 /// `tf` (given for the volume modes) and its light volume for volumetric shadows unless
 /// `--shadow-rays`, the wide BVH when secondary or bounced rays use it.
-fn scene_settings(
+pub(crate) fn scene_settings(
     args: &RenderArgs,
     input: &InputArgs,
     tf: Option<TransferFunction>,
@@ -432,7 +456,7 @@ fn scene_settings(
 }
 
 /// Background colour: `--background`, else white for `bs` and near-black for the others.
-fn background(args: &RenderArgs) -> [u8; 3] {
+pub(crate) fn background(args: &RenderArgs) -> [u8; 3] {
     args.background.unwrap_or(if args.mode == Mode::Bs {
         WHITE_BACKGROUND
     } else {

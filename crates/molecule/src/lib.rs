@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 pub mod bonds;
 pub mod elements;
+pub mod motion;
 pub mod read;
 pub mod scenes;
 pub mod write;

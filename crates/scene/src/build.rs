@@ -57,8 +57,11 @@ pub struct DensityVolume {
     pub volume: Volume,
     /// Its macrocells.
     pub cells: Macrocells,
-    /// The transfer function classified over `[0, volume.max_value]`.
+    /// The transfer function classified over `[0, tf_max]`.
     pub tf: ClassifiedTf,
+    /// The density at the top of the transfer function: `VolumeSettings::density_max`, or
+    /// the volume's maximum.
+    pub tf_max: f32,
 }
 
 /// Everything the renderer traces for one frame of a molecule.
@@ -176,9 +179,25 @@ impl Scene {
             progress(Stage::Macrocells);
             let t = Instant::now();
             let cells = Macrocells::build(&volume);
-            let tf = ClassifiedTf::new(&vs.tf, 0.0, volume.max_value, vs.step_voxels);
+            let tf_max = match vs.density_max {
+                Some(d) if d > 0.0 && d.is_finite() => d,
+                Some(d) => {
+                    return Err(SceneError::BadSetting {
+                        name: "density-max",
+                        expected: "a positive number",
+                        value: d,
+                    })
+                }
+                None => volume.max_value,
+            };
+            let tf = ClassifiedTf::new(&vs.tf, 0.0, tf_max, vs.step_voxels);
             self.timings.macrocells = t.elapsed().as_secs_f64();
-            let d = DensityVolume { volume, cells, tf };
+            let d = DensityVolume {
+                volume,
+                cells,
+                tf,
+                tf_max,
+            };
             if let Some(lv) = &vs.light_volume {
                 progress(Stage::LightVolume);
                 let t = Instant::now();

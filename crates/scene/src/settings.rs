@@ -136,6 +136,9 @@ pub struct VolumeSettings {
     pub step_voxels: f32,
     /// Precomputed light volume (`None`: none, shadows march shadow rays if asked).
     pub light_volume: Option<LightVolumeSettings>,
+    /// Density mapped to the top of the transfer function (density units, > 0; `None`: the
+    /// frame's maximum). Fixed across a trajectory so the pictures do not flicker.
+    pub density_max: Option<f32>,
 }
 
 impl Default for VolumeSettings {
@@ -146,6 +149,7 @@ impl Default for VolumeSettings {
             tf: TransferFunction::preset(volume::Preset::CoolWarm),
             step_voxels: 0.5,
             light_volume: None,
+            density_max: None,
         }
     }
 }

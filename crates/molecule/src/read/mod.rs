@@ -24,6 +24,7 @@ use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Supported file formats.
@@ -277,7 +278,52 @@ fn new_parser(format: Format, opts: &ReadOptions) -> Box<dyn FrameParser> {
 
 /// Open `path` as a byte stream (gzip-decoded if it starts with the gzip magic), positioned at
 /// byte `offset` of the *decoded* stream (seek for plain files, skip for gzip).
-fn open_stream(path: &Path, offset: u64) -> Result<(Box<dyn Read + Send>, bool), ReadError> {
+/// A reader that adds the bytes it yields to a shared count (bytes decoded: after
+/// decompression for gzip).
+struct Counted<R> {
+    inner: R,
+    count: Arc<AtomicU64>,
+}
+
+impl<R: Read> Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.count.fetch_add(n as u64, Ordering::Relaxed);
+        Ok(n)
+    }
+}
+
+/// [`open_stream_plain`] counting every decoded byte (skipped ones included) in `count`.
+fn open_stream(
+    path: &Path,
+    offset: u64,
+    count: &Arc<AtomicU64>,
+) -> Result<(Box<dyn Read + Send>, bool), ReadError> {
+    let (src, gz) = open_stream_plain(path, 0)?;
+    let mut src: Box<dyn Read + Send> = Box::new(Counted {
+        inner: src,
+        count: count.clone(),
+    });
+    if offset > 0 {
+        if gz {
+            io::copy(&mut (&mut src).take(offset), &mut io::sink()).map_err(|error| {
+                ReadError::Io {
+                    path: path.to_path_buf(),
+                    error,
+                }
+            })?;
+        } else {
+            let (f, _) = open_stream_plain(path, offset)?;
+            src = Box::new(Counted {
+                inner: f,
+                count: count.clone(),
+            });
+        }
+    }
+    Ok((src, gz))
+}
+
+fn open_stream_plain(path: &Path, offset: u64) -> Result<(Box<dyn Read + Send>, bool), ReadError> {
     let io_err = |error| ReadError::Io {
         path: path.to_path_buf(),
         error,
@@ -310,7 +356,7 @@ fn open_stream(path: &Path, offset: u64) -> Result<(Box<dyn Read + Send>, bool),
 }
 
 fn sniff(path: &Path) -> Result<Option<Format>, ReadError> {
-    let (src, _) = open_stream(path, 0)?;
+    let (src, _) = open_stream_plain(path, 0)?;
     let mut r = LineReader::new(src, Arc::from(path));
     // The first lines (raw, up to 40) for the format-specific checks below.
     let mut head: Vec<Vec<u8>> = Vec::new();
@@ -387,7 +433,8 @@ pub fn open(path: &Path, opts: &ReadOptions) -> Result<Trajectory, ReadError> {
             path: path.to_path_buf(),
         })?,
     };
-    let (src, gz) = open_stream(path, 0)?;
+    let decoded = Arc::new(AtomicU64::new(0));
+    let (src, gz) = open_stream(path, 0, &decoded)?;
     let path: Arc<Path> = Arc::from(path);
     let reader = LineReader::new(src, path.clone());
     Ok(Trajectory {
@@ -403,6 +450,7 @@ pub fn open(path: &Path, opts: &ReadOptions) -> Result<Trajectory, ReadError> {
         failed: false,
         tail_warning: None,
         all_warnings: Vec::new(),
+        decoded,
     })
 }
 
@@ -439,6 +487,8 @@ pub struct Trajectory {
     tail_warning: Option<String>,
     /// Parser warnings plus `tail_warning`, rebuilt by [`Trajectory::warnings`].
     all_warnings: Vec<String>,
+    /// Bytes decoded from the file so far, over every pass ([`Trajectory::decoded_bytes`]).
+    decoded: Arc<AtomicU64>,
 }
 
 impl Trajectory {
@@ -450,6 +500,13 @@ impl Trajectory {
     /// Path being read.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Bytes read from the file so far — decompressed bytes for gzip — summed over every pass
+    /// (counting frames, seeking back, reading on): a single sequential read of the whole file
+    /// decodes its (uncompressed) size once.
+    pub fn decoded_bytes(&self) -> u64 {
+        self.decoded.load(Ordering::Relaxed)
     }
 
     /// Whether the file is gzip-compressed.
@@ -505,7 +562,7 @@ impl Trajectory {
         if let Some(c) = self.count {
             return Ok(c);
         }
-        let (src, _) = open_stream(&self.path, 0)?;
+        let (src, _) = open_stream(&self.path, 0, &self.decoded)?;
         let mut r = LineReader::new(src, self.path.clone());
         let mut p = new_parser(self.format, &self.opts);
         let mut starts = Vec::new();
@@ -559,7 +616,7 @@ impl Trajectory {
             // Data files have a header shared by all frames: only seek formats with
             // self-contained frames.
             if self.format != Format::LammpsData {
-                let (src, _) = open_stream(&self.path, off)?;
+                let (src, _) = open_stream(&self.path, off, &self.decoded)?;
                 self.reader = LineReader::new(src, self.path.clone());
                 self.reader.set_position(off, line);
                 self.parser = new_parser(self.format, &self.opts);
@@ -567,7 +624,7 @@ impl Trajectory {
                 return Ok(());
             }
         }
-        let (src, _) = open_stream(&self.path, 0)?;
+        let (src, _) = open_stream(&self.path, 0, &self.decoded)?;
         self.reader = LineReader::new(src, self.path.clone());
         self.parser = new_parser(self.format, &self.opts);
         self.next_index = 0;

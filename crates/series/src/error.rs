@@ -1,0 +1,73 @@
+//! Why a series stopped.
+
+use std::path::{Path, PathBuf};
+
+/// Errors of [`crate::render_series`] and its outputs.
+#[derive(Debug, thiserror::Error)]
+pub enum SeriesError {
+    /// Reading a frame failed.
+    #[error(transparent)]
+    Read(#[from] molecule::read::ReadError),
+    /// Building a frame's scene failed.
+    #[error("frame {frame}: {error}")]
+    Scene {
+        /// Frame index in the file.
+        frame: usize,
+        /// Why.
+        error: scene::SceneError,
+    },
+    /// Rendering or writing an image failed.
+    #[error(transparent)]
+    Render(#[from] render::RenderError),
+    /// The render settings are invalid.
+    #[error(transparent)]
+    Settings(#[from] render::SettingsError),
+    /// An output exists and overwriting was not asked for.
+    #[error("{} exists; pass --force to overwrite it", .0.display())]
+    Exists(PathBuf),
+    /// A numbered output without one `%d` / `%0Nd`.
+    #[error("{0}: a series of frames needs a numbered name with one %d or %0Nd (e.g. out_%05d.png), or a .gif")]
+    Pattern(String),
+    /// A video was asked for and `ffmpeg` is not on PATH.
+    #[error("{0}: videos are encoded by ffmpeg, which is not on PATH (install it, e.g. apt install ffmpeg); or write numbered PNGs (-o out_%05d.png) or an animated .gif instead")]
+    Video(String),
+    /// The range selects no frame of the file.
+    #[error("--frames {range}: the file has {count} frame(s), none of them in the range")]
+    NoFrames {
+        /// The range asked for.
+        range: String,
+        /// Frames in the file.
+        count: usize,
+    },
+    /// File system error.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Image encoder error.
+    #[error("writing {path}: {source}")]
+    Image {
+        /// The file.
+        path: String,
+        /// Why.
+        source: image::ImageError,
+    },
+}
+
+impl SeriesError {
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> SeriesError {
+        SeriesError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+    pub(crate) fn image(path: &Path, source: image::ImageError) -> SeriesError {
+        SeriesError::Image {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+}

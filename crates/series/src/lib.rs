@@ -1,0 +1,18 @@
+//! Time series (paper §4, issue #15): the frames of a trajectory rendered in order, in one
+//! pass through the file, with the next frame read and its scene (bonds, BVH, volume) built
+//! on a background thread while the current one renders. The camera and the colour and
+//! density ranges are fixed by the first frame, so a movie does not jump or flicker. Frames go
+//! to numbered PNG/JPEG files or an animated GIF ([`Sink`]).
+//!
+//! Units: positions in Ångström (Å), times in seconds.
+#![warn(missing_docs)]
+
+mod error;
+mod output;
+mod range;
+mod run;
+
+pub use error::SeriesError;
+pub use output::{expand, OutputKind, Sink, DEFAULT_GIF_FPS};
+pub use range::{FrameRange, FrameRangeError};
+pub use run::{render_series, CameraChoice, FrameReport, SeriesReport, SeriesSettings};

@@ -1,0 +1,307 @@
+//! The series loop: frames read and their scenes built on a background thread one frame
+//! ahead of the renderer (paper §4: the next time step is prepared while the current one is
+//! shown), at most two scenes alive.
+
+use std::sync::mpsc::sync_channel;
+use std::time::Instant;
+
+use molecule::read::Trajectory;
+use molecule::Molecule;
+use render::{draw_legend, render_frame, Camera, FrameInputs, Framebuffer, Legend, RenderSettings};
+use scene::{ColorBy, Orbit, Scene, SceneSettings, View};
+use spmd::Isa;
+
+use crate::{FrameRange, SeriesError, Sink};
+
+/// How the camera of the series is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CameraChoice {
+    /// This camera for every frame.
+    Fixed(Camera),
+    /// Fitted once, to the first rendered frame's bounding sphere.
+    Fit {
+        /// Distance preset.
+        view: View,
+        /// Direction and zoom around the centre.
+        orbit: Orbit,
+        /// Vertical field of view (degrees).
+        fov_deg: f32,
+    },
+}
+
+/// Everything a series is rendered with.
+#[derive(Clone, Debug)]
+pub struct SeriesSettings {
+    /// Frames of the file to render.
+    pub frames: FrameRange,
+    /// What each frame's scene holds. A column colour range or density range left `None` is
+    /// taken from the first rendered frame and kept for the rest.
+    pub scene: SceneSettings,
+    /// How each frame is rendered.
+    pub render: RenderSettings,
+    /// Image size (pixels).
+    pub size: (u32, u32),
+    /// The camera.
+    pub camera: CameraChoice,
+    /// Draw a colour legend (when colouring by a column) with text of this colour.
+    pub legend_ink: Option<[u8; 3]>,
+    /// Build the next frame on a background thread while this one renders (off: one after
+    /// the other, for comparison).
+    pub pipelined: bool,
+    /// SIMD backend of the builds and the renderer.
+    pub isa: Isa,
+}
+
+/// What one frame took (seconds).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameReport {
+    /// Frame index in the file.
+    pub frame: usize,
+    /// Atoms in the frame.
+    pub atoms: usize,
+    /// Reading (and skipping the frames before it).
+    pub read_s: f64,
+    /// Building its scene.
+    pub build_s: f64,
+    /// Time the renderer waited for it (0 when the build was hidden behind rendering).
+    pub wait_s: f64,
+    /// Rendering.
+    pub render_s: f64,
+    /// Encoding and writing the image.
+    pub write_s: f64,
+    /// Where it went.
+    pub path: std::path::PathBuf,
+}
+
+/// What a whole series took.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeriesReport {
+    /// Frames rendered.
+    pub frames: usize,
+    /// Wall time (s).
+    pub wall_s: f64,
+    /// Sums over the frames of read + build time, and of the renderer's waits (s): the
+    /// difference is the build time hidden behind rendering.
+    pub build_s: f64,
+    /// Sum of the renderer's waits for the next scene (s).
+    pub wait_s: f64,
+    /// The camera used.
+    pub camera: Option<Camera>,
+    /// The column colour range used, when colouring by a column.
+    pub color_range: Option<(f32, f32)>,
+    /// The density mapped to the transfer function's top, when there is a volume.
+    pub density_max: Option<f32>,
+}
+
+/// A frame read and built, ready to render.
+struct Built {
+    frame: usize,
+    atoms: usize,
+    scene: Scene,
+    read_s: f64,
+    build_s: f64,
+}
+
+/// Reads on to the next frame in `range` (skipping the others without building them).
+fn next_molecule(
+    traj: &mut Trajectory,
+    range: &FrameRange,
+    next: &mut usize,
+) -> Result<Option<(usize, Molecule)>, SeriesError> {
+    loop {
+        if range.end.is_some_and(|e| *next >= e) {
+            return Ok(None);
+        }
+        let k = *next;
+        let Some(m) = traj.next() else {
+            return Ok(None);
+        };
+        let m = m?;
+        *next += 1;
+        if range.contains(k) {
+            return Ok(Some((k, m)));
+        }
+    }
+}
+
+/// Reads and builds the next frame in range with `settings`.
+fn read_and_build(
+    traj: &mut Trajectory,
+    range: &FrameRange,
+    next: &mut usize,
+    settings: &SceneSettings,
+    isa: Isa,
+) -> Result<Option<Built>, SeriesError> {
+    let t = Instant::now();
+    let Some((frame, m)) = next_molecule(traj, range, next)? else {
+        return Ok(None);
+    };
+    let read_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let scene =
+        Scene::build(isa, &m, settings).map_err(|error| SeriesError::Scene { frame, error })?;
+    Ok(Some(Built {
+        frame,
+        atoms: m.len(),
+        scene,
+        read_s,
+        build_s: t.elapsed().as_secs_f64(),
+    }))
+}
+
+/// Renders the frames `s.frames` of `traj` (read from its current position onwards, once)
+/// to `sink`, calling `on_frame` after each one is written.
+/// On an error a GIF or video being written is removed ([`Sink::abandon`]).
+pub fn render_series(
+    traj: &mut Trajectory,
+    s: &SeriesSettings,
+    sink: &mut Sink,
+    on_frame: &mut dyn FnMut(&FrameReport),
+) -> Result<SeriesReport, SeriesError> {
+    let r = run_series(traj, s, sink, on_frame);
+    if r.is_err() {
+        sink.abandon();
+    }
+    r
+}
+
+fn run_series(
+    traj: &mut Trajectory,
+    s: &SeriesSettings,
+    sink: &mut Sink,
+    on_frame: &mut dyn FnMut(&FrameReport),
+) -> Result<SeriesReport, SeriesError> {
+    s.render
+        .validate(s.scene.model.is_some(), s.scene.volume.is_some())?;
+    let wall = Instant::now();
+    let mut next = 0usize;
+    let mut settings = s.scene.clone();
+    // The first frame fixes the camera and the ranges.
+    let Some(first) = read_and_build(traj, &s.frames, &mut next, &settings, s.isa)? else {
+        return Err(SeriesError::NoFrames {
+            range: s.frames.to_string(),
+            count: next,
+        });
+    };
+    let (w, h) = s.size;
+    let camera = match s.camera {
+        CameraChoice::Fixed(c) => c,
+        CameraChoice::Fit {
+            view,
+            orbit,
+            fov_deg,
+        } => Camera::fit(
+            view,
+            first.scene.sphere,
+            fov_deg,
+            w as f32 / h as f32,
+            orbit,
+        ),
+    };
+    let color_range = first.scene.model.as_ref().and_then(|m| m.color_range);
+    if let Some(ms) = settings.model.as_mut() {
+        if let ColorBy::Column { range, .. } = &mut ms.color {
+            *range = range.or(color_range);
+        }
+    }
+    let density_max = first.scene.volume.as_ref().map(|d| d.tf_max);
+    if let Some(vs) = settings.volume.as_mut() {
+        vs.density_max = vs.density_max.or(density_max);
+    }
+    let mut report = SeriesReport {
+        camera: Some(camera),
+        color_range,
+        density_max,
+        ..SeriesReport::default()
+    };
+    let legend = match (&settings.model, s.legend_ink, color_range) {
+        (Some(ms), Some(ink), Some((lo, hi))) => match &ms.color {
+            ColorBy::Column { name, colormap, .. } => Some((
+                Legend {
+                    title: name.clone(),
+                    lo,
+                    hi,
+                    colormap: *colormap,
+                },
+                ink,
+            )),
+            ColorBy::Element => None,
+        },
+        _ => None,
+    };
+    let mut render_one = |b: Built, wait_s: f64| -> Result<(), SeriesError> {
+        let t = Instant::now();
+        let vscene = b.scene.volume_scene(s.render.march);
+        let inputs = FrameInputs {
+            model: b.scene.model.as_ref(),
+            volume: vscene.as_ref(),
+            camera: &camera,
+        };
+        let mut fb = Framebuffer::new(w, h, s.render.background_packed())?;
+        render_frame(&inputs, &s.render, &mut fb, s.isa)?;
+        if let Some((l, ink)) = &legend {
+            draw_legend(&mut fb, l, *ink);
+        }
+        let render_s = t.elapsed().as_secs_f64();
+        drop(b.scene);
+        let t = Instant::now();
+        let path = sink.write(b.frame, &fb)?;
+        let r = FrameReport {
+            frame: b.frame,
+            atoms: b.atoms,
+            read_s: b.read_s,
+            build_s: b.build_s,
+            wait_s,
+            render_s,
+            write_s: t.elapsed().as_secs_f64(),
+            path,
+        };
+        report.frames += 1;
+        report.build_s += r.read_s + r.build_s;
+        report.wait_s += wait_s;
+        on_frame(&r);
+        Ok(())
+    };
+    let first_wait = first.read_s + first.build_s;
+    if !s.pipelined {
+        render_one(first, first_wait)?;
+        while let Some(b) = read_and_build(traj, &s.frames, &mut next, &settings, s.isa)? {
+            let wait = b.read_s + b.build_s;
+            render_one(b, wait)?;
+        }
+    } else {
+        // A rendezvous channel: the builder blocks with frame k+1 built until the renderer
+        // takes it, so at most two scenes are alive (k rendering, k+1 waiting).
+        let (tx, rx) = sync_channel::<Result<Built, SeriesError>>(0);
+        let settings = &settings;
+        let frames = &s.frames;
+        std::thread::scope(|scope| -> Result<(), SeriesError> {
+            // Owned here, so an error return drops it and a builder blocked on `send` exits.
+            let rx = rx;
+            scope.spawn(move || loop {
+                match read_and_build(traj, frames, &mut next, settings, s.isa) {
+                    Ok(Some(b)) => {
+                        if tx.send(Ok(b)).is_err() {
+                            return;
+                        }
+                    }
+                    Ok(None) => return,
+                    Err(e) => {
+                        tx.send(Err(e)).ok();
+                        return;
+                    }
+                }
+            });
+            render_one(first, first_wait)?;
+            loop {
+                let t = Instant::now();
+                let Ok(b) = rx.recv() else { break };
+                render_one(b?, t.elapsed().as_secs_f64())?;
+            }
+            Ok(())
+        })?;
+    }
+    sink.finish()?;
+    report.wall_s = wall.elapsed().as_secs_f64();
+    Ok(report)
+}

@@ -1,0 +1,139 @@
+//! `bnsview render FILE --frames …`: a trajectory to numbered images or an animated GIF
+//! through the `series` crate (one pass through the file, the next frame built in the
+//! background).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use render::Camera;
+use series::{render_series, CameraChoice, OutputKind, SeriesSettings, Sink};
+use spmd::Isa;
+use volume::TransferFunction;
+
+use crate::input::InputArgs;
+use crate::render_cmd::{background, render_settings, scene_settings, Mode, RenderArgs};
+
+/// Renders `args.frames` of the input file.
+pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
+    let Some(frames) = args.frames else {
+        bail!("internal: series without --frames");
+    };
+    let Some(path) = input.file.clone() else {
+        bail!("--frames renders the frames of a trajectory file; built-in scenes have one frame");
+    };
+    let output = args.output.clone().unwrap_or_else(|| {
+        let stem = path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "bnsview".into());
+        let stem = stem.split('.').next().unwrap_or("bnsview").to_string();
+        PathBuf::from(format!("{stem}_%05d.png"))
+    });
+    let kind = OutputKind::from_path(&output)?;
+    let tf = if matches!(args.mode, Mode::Bs | Mode::Path) {
+        None
+    } else {
+        Some(TransferFunction::from_spec(&args.tf)?)
+    };
+    let scene = scene_settings(args, input, tf)?;
+    let render = render_settings(args);
+    let (w, h) = args.size;
+    let camera = match &args.camera {
+        Some(spec) => CameraChoice::Fixed(spec.parse::<Camera>()?),
+        None => {
+            let (view, mut orbit) = args.view.view_and_orbit();
+            if let Some(o) = args.orbit {
+                (orbit.azimuth_deg, orbit.elevation_deg) = (o.azimuth_deg, o.elevation_deg);
+            }
+            orbit.zoom = args.zoom;
+            CameraChoice::Fit {
+                view,
+                orbit,
+                fov_deg: args.fov,
+            }
+        }
+    };
+    let legend_ink = args.geometry.legend.then(|| {
+        let [r, g, b] = background(args);
+        let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
+        if luma > 128.0 {
+            [0, 0, 0]
+        } else {
+            [255, 255, 255]
+        }
+    });
+    let settings = SeriesSettings {
+        frames,
+        scene,
+        render,
+        size: (w, h),
+        camera,
+        legend_ink,
+        pipelined: !args.no_pipeline,
+        isa,
+    };
+    let mut traj = input.open_trajectory(&path)?;
+    let mut sink = Sink::open(&kind, args.force, args.gif_fps)?;
+    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} {pos} frames written ({elapsed}) {msg}")
+    {
+        pb.set_style(style);
+    }
+    pb.enable_steady_tick(std::time::Duration::from_millis(500));
+    let verbose = args.verbose;
+    let report = render_series(&mut traj, &settings, &mut sink, &mut |r| {
+        pb.inc(1);
+        pb.set_message(format!("frame {} → {}", r.frame, r.path.display()));
+        if verbose {
+            pb.suspend(|| {
+                eprintln!(
+                    "frame {:>5}: {} atoms, read {:.3} s, build {:.3} s, waited {:.3} s, render {:.3} s, write {:.3} s → {}",
+                    r.frame, r.atoms, r.read_s, r.build_s, r.wait_s, r.render_s, r.write_s, r.path.display()
+                )
+            });
+        }
+    })
+    .with_context(|| format!("rendering the frames of {}", path.display()))?;
+    pb.finish_and_clear();
+    for warning in traj.warnings() {
+        eprintln!("warning: {warning}");
+    }
+    if verbose {
+        eprintln!(
+            "isa:     {isa} ({} lanes), {} threads",
+            isa.lanes(),
+            rayon::current_num_threads()
+        );
+        if let Some(c) = report.camera {
+            eprintln!("camera:  --camera {c}");
+        }
+        if let Some((lo, hi)) = report.color_range {
+            eprintln!("color:   --color-range {lo}:{hi} (fixed by the first frame)");
+        }
+        if let Some(d) = report.density_max {
+            eprintln!("volume:  --density-max {d} (fixed by the first frame)");
+        }
+        let hidden = (report.build_s - report.wait_s).max(0.0);
+        eprintln!(
+            "series:  {} frames in {:.2} s ({:.2} frames/s); read+build {:.2} s, of which {:.2} s hidden behind rendering{}; {} MB read from {}",
+            report.frames,
+            report.wall_s,
+            report.frames as f64 / report.wall_s.max(1e-9),
+            report.build_s,
+            hidden,
+            if settings.pipelined { "" } else { " (--no-pipeline)" },
+            traj.decoded_bytes() / 1_000_000,
+            path.display()
+        );
+    }
+    eprintln!(
+        "wrote {} frame(s) of {} to {} ({w}x{h}, {}, {isa})",
+        report.frames,
+        path.display(),
+        output.display(),
+        args.mode.name()
+    );
+    Ok(())
+}

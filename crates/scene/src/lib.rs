@@ -24,7 +24,10 @@ pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
 pub use error::SceneError;
 pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ATOM_SPHERE_PAD};
-pub use memory::{MemoryEstimate, BVH_NODES_PER_PRIM, WIDE_NODES_PER_PRIM};
+pub use memory::{
+    retained_bytes, MemoryEstimate, Peak, PeakPhase, BASELINE_BYTES, BVH_NODES_PER_PRIM,
+    WIDE_NODES_PER_PRIM,
+};
 pub use model::{Coloring, Model, ModelOptions, Style};
 pub use settings::{
     BondSettings, BondSource, ColorBy, LightVolumeSettings, ModelSettings, RadiusKind,

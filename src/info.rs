@@ -15,6 +15,9 @@ pub struct InfoArgs {
     /// Voxels per Å for the volume memory estimate.
     #[arg(long, default_value_t = 4.0)]
     pub voxels_per_angstrom: f32,
+    /// Image size of the memory estimate, WIDTHxHEIGHT pixels (as `render --size`).
+    #[arg(long, default_value = "1024x1024", value_parser = crate::render_cmd::parse_size)]
+    pub size: (u32, u32),
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
@@ -39,22 +42,9 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
         anyhow::bail!("give a molecule FILE or --scene NAME (nanobowl, ns90k, ns740k, sio2, anp3)");
     }
     let l = args.input.load(true)?;
-    // The same estimate `render` checks before allocating: default model (with the wide
-    // BVH) and a u8 volume at --voxels-per-angstrom.
-    let settings = scene::SceneSettings {
-        model: Some(scene::ModelSettings {
-            wide_bvh: true,
-            ..Default::default()
-        }),
-        volume: (!l.molecule.is_empty()).then(|| scene::VolumeSettings {
-            voxels_per_angstrom: args.voxels_per_angstrom,
-            ..Default::default()
-        }),
-        ..Default::default()
-    };
-    let est = scene::MemoryEstimate::new(&l.molecule, l.bonds.len(), &settings)?;
+    let modes = mode_estimates(&l.molecule, l.bonds.len(), &args)?;
     report(
-        &est,
+        &modes,
         &args,
         &l.source,
         &l.molecule,
@@ -69,9 +59,48 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The `render` modes `info` estimates: name and estimate.
+type ModeEstimates = Vec<(&'static str, scene::MemoryEstimate)>;
+
+/// The estimate `render` checks before allocating, for each mode at `--size` with a u8
+/// volume at `--voxels-per-angstrom`: `bs` (model, packets only), `volume` (density alone),
+/// `vol+bs` (both) and `path` (model with the wide BVH). The volume modes are left out for
+/// a molecule without atoms.
+fn mode_estimates(m: &Molecule, bonds: usize, args: &InfoArgs) -> anyhow::Result<ModeEstimates> {
+    let bonds_settings = args.input.bond_settings()?;
+    let model = |wide_bvh| {
+        Some(scene::ModelSettings {
+            wide_bvh,
+            ..Default::default()
+        })
+    };
+    let volume = Some(scene::VolumeSettings {
+        voxels_per_angstrom: args.voxels_per_angstrom,
+        ..Default::default()
+    });
+    let mut modes = vec![("bs", model(false), None), ("path", model(true), None)];
+    if !m.is_empty() {
+        modes.insert(1, ("volume", None, volume.clone()));
+        modes.insert(2, ("vol+bs", model(false), volume));
+    }
+    modes
+        .into_iter()
+        .map(|(name, model, volume)| {
+            let settings = scene::SceneSettings {
+                model,
+                volume,
+                bonds: bonds_settings.clone(),
+                frame: Some(args.size),
+                ..Default::default()
+            };
+            Ok((name, scene::MemoryEstimate::new(m, bonds, &settings)?))
+        })
+        .collect()
+}
+
 #[allow(clippy::too_many_arguments)]
 fn report(
-    est: &scene::MemoryEstimate,
+    modes: &ModeEstimates,
     args: &InfoArgs,
     source: &str,
     m: &Molecule,
@@ -83,6 +112,12 @@ fn report(
     bond_s: f64,
     warnings: &[String],
 ) {
+    // The breakdown shown is the largest mode at rest (vol+bs, or bs without atoms).
+    let est = modes
+        .iter()
+        .find(|(n, _)| *n == "vol+bs")
+        .unwrap_or(&modes[0]);
+    let est = &est.1;
     let (lo, hi) = m.bounds();
     let n = m.len() as u64;
     let nb = bonds.len() as u64;
@@ -112,8 +147,17 @@ fn report(
             "load_seconds": load_s,
             "bond_seconds": bond_s,
             "molecule_bytes": m.memory_bytes(),
+            "peak_rss_estimate": modes.iter().map(|(n, e)| (n.to_string(), serde_json::json!({
+                "bytes": e.peak_bytes(),
+                "phase": e.peak.phase.name(),
+                "live": e.peak.live,
+                "retained": e.peak.retained,
+                "baseline": e.peak.baseline,
+                "at_rest": e.total(),
+            }))).collect::<serde_json::Map<_, _>>(),
             "memory_estimate": est.components().iter().map(|(k, b)| (k.to_string(), serde_json::json!(b))).chain([
                 ("total".to_string(), serde_json::json!(est.total())),
+                ("peak".to_string(), serde_json::json!(est.peak_bytes())),
                 ("volume_dims".to_string(), serde_json::json!(dims)),
                 ("voxels_per_angstrom".to_string(), serde_json::json!(vpa)),
             ]).collect::<serde_json::Map<_, _>>(),
@@ -176,14 +220,27 @@ fn report(
         "molecule:  {:.1} MB in memory",
         mb(m.memory_bytes() as u64)
     );
+    let (w, h) = args.size;
     p!(
         out,
-        "memory:    ~{:.1} MB estimated for a default render with the wide BVH and a u8 volume:",
-        mb(est.total())
+        "memory:    estimated peak RSS of `render --size {w}x{h}` (u8 volume at {vpa} /Å):"
     );
+    for (name, e) in modes {
+        let pk = &e.peak;
+        p!(
+            out,
+            "  {name:<12} {:>10.1} MB  ({}: {:.1} MB alive + {:.1} MB kept by the allocator + {:.1} MB baseline)",
+            mb(e.peak_bytes()),
+            pk.phase.name(),
+            mb(pk.live),
+            mb(pk.retained),
+            mb(pk.baseline)
+        );
+    }
+    p!(out, "  at rest (vol+bs), {:.1} MB:", mb(est.total()));
     for (name, bytes) in est.components() {
         if bytes > 0 {
-            p!(out, "  {name:<12} {:>10.1} MB", mb(bytes));
+            p!(out, "    {name:<12} {:>10.1} MB", mb(bytes));
         }
     }
     p!(

@@ -32,9 +32,11 @@ fn main() -> Result<()> {
             Ok(())
         }
         Some("asm") if args.len() == 2 => asm::print_matching(&args[1]),
+        Some("fuzz") => fuzz(&args[1..]),
         _ => {
             eprintln!("usage: cargo xtask matrix [--quick] | cargo xtask bench [BENCH ARGS]");
             eprintln!("       cargo xtask asm-check | cargo xtask asm <PATTERN>");
+            eprintln!("       cargo xtask fuzz [--cases N]");
             eprintln!("  matrix   tests per ISA, kernel benches with speedups over scalar,");
             eprintln!("           builds for target-cpu x86-64 / x86-64-v3 / x86-64-v4");
             eprintln!("  --quick  short bench runs (criterion --quick), one wider baseline: the");
@@ -43,6 +45,9 @@ fn main() -> Result<()> {
             eprintln!("           e.g. cargo xtask bench --quick --json out.json");
             eprintln!("  asm-check  disassembly check of the SPMD entry points (table RULES in");
             eprintln!("           xtask/src/asm.rs; built into target/asm with v0 mangling)");
+            eprintln!("  fuzz     the readers' mutation fuzz test, long: cargo test --release -p");
+            eprintln!("           molecule --test fuzz with BNS_FUZZ_CASES=N per reader (default");
+            eprintln!("           {FUZZ_CASES}; CI runs 10,000)");
             eprintln!("  asm      print the disassembly of functions whose name contains PATTERN,");
             eprintln!("           e.g. cargo xtask asm 'avx2::entry::<volume::march::MarchBatch'");
             std::process::exit(2)
@@ -69,6 +74,34 @@ fn bench(args: &[String]) -> Result<()> {
         .context("running cargo run --release -- bench")?;
     if !status.success() {
         bail!("bnsview bench failed ({status})");
+    }
+    Ok(())
+}
+
+/// Mutated inputs per reader of `cargo xtask fuzz` without `--cases` (CI runs 10,000).
+const FUZZ_CASES: u64 = 200_000;
+
+/// `cargo xtask fuzz [--cases N]`: `cargo test --release -p molecule --test fuzz` with
+/// `BNS_FUZZ_CASES=N` (default [`FUZZ_CASES`]), the nightly-style long run of issue #20.
+fn fuzz(args: &[String]) -> Result<()> {
+    let cases = match args {
+        [] => FUZZ_CASES,
+        [flag, n] if flag == "--cases" => n
+            .parse::<u64>()
+            .ok()
+            .filter(|&n| n > 0 && n <= u32::MAX as u64)
+            .with_context(|| format!("--cases {n}: expected a whole number from 1 to 2^32 - 1"))?,
+        _ => bail!("usage: cargo xtask fuzz [--cases N]"),
+    };
+    let cmd = ["test", "--release", "-p", "molecule", "--test", "fuzz"];
+    eprintln!("xtask: BNS_FUZZ_CASES={cases} cargo {}", cmd.join(" "));
+    let status = cargo()
+        .args(cmd)
+        .env("BNS_FUZZ_CASES", cases.to_string())
+        .status()
+        .context("running cargo test --release -p molecule --test fuzz")?;
+    if !status.success() {
+        bail!("fuzz test failed ({status})");
     }
     Ok(())
 }

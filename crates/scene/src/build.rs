@@ -149,9 +149,14 @@ impl Scene {
         } else {
             self.bonds.clear();
         }
-        // Check the budget before the large allocations (the frame and bonds already exist).
+        // Check the budget before the large allocations: the estimated peak of the process
+        // (the figure `bnsview info` prints) less what is already resident (the baseline,
+        // the frame and the bonds), since the budget is a share of the memory still available.
         self.estimate = MemoryEstimate::new(m, self.bonds.len(), st)?;
-        let needed = self.estimate.total() - self.estimate.atoms - self.estimate.bonds;
+        let e = &self.estimate;
+        let needed = e
+            .peak_bytes()
+            .saturating_sub(e.peak.baseline + e.atoms + self.bonds.len() as u64 * 8);
         if let Some(budget) = st.budget_bytes.or_else(volume::default_budget_bytes) {
             if needed > budget {
                 return Err(SceneError::TooLarge {
@@ -209,6 +214,12 @@ impl Scene {
         }
         self.sphere = bounding_sphere(m, self.model.as_ref());
         Ok(())
+    }
+
+    /// Bytes of the per-atom scratch kept between frames (capacity of the radius and colour
+    /// vectors).
+    pub(crate) fn scratch_bytes(&self) -> u64 {
+        (self.scratch.0.capacity() * 4 + self.scratch.1.capacity() * 4) as u64
     }
 
     /// The marcher's view of the volume with options `opts`, with the light volume attached

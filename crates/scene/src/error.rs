@@ -46,7 +46,8 @@ pub enum SceneError {
     #[error("the scene would need about {} MB ({}), over the memory budget of {} MB",
         needed / 1_000_000, breakdown, budget / 1_000_000)]
     TooLarge {
-        /// Estimated bytes ([`crate::MemoryEstimate::total`]).
+        /// Estimated bytes still to allocate: [`crate::MemoryEstimate::peak_bytes`] less the
+        /// baseline, the frame and the bonds already resident.
         needed: u64,
         /// Allowed bytes.
         budget: u64,

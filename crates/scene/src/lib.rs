@@ -25,7 +25,10 @@ pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
 pub use error::SceneError;
 pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD};
-pub use memory::{MemoryEstimate, BVH_NODES_PER_PRIM, WIDE_NODES_PER_PRIM};
+pub use memory::{
+    retained_bytes, MemoryEstimate, Peak, PeakPhase, BASELINE_BYTES, BVH_NODES_PER_PRIM,
+    WIDE_NODES_PER_PRIM,
+};
 pub use model::{Coloring, Model, ModelOptions, Style, CELL_COLOR};
 pub use periodic::{add_cell_edges, split_periodic_sticks};
 pub use settings::{

@@ -1,13 +1,18 @@
 //! One memory estimate per component, computed before anything large is allocated from the
 //! same sizes the build uses (element radii, the density [`Grid`], the light-volume stride),
-//! and the same figures measured on a built [`Scene`] to check it.
+//! and the same figures measured on a built [`Scene`] to check it; plus the peak resident set
+//! of a `render` process ([`MemoryEstimate::peak_bytes`], modelled in [`peak`]).
 
-use molecule::Molecule;
+use molecule::{elements, Molecule};
 use volume::{Grid, MACROCELL};
 
 use crate::build::{density_grid, model_prim_count, Scene};
 use crate::settings::SceneSettings;
 use crate::SceneError;
+
+mod peak;
+
+pub use peak::{retained_bytes, Peak, PeakPhase, BASELINE_BYTES};
 
 /// Binary BVH nodes per primitive (binned SAH builder, leaves of ≤ 4): measured 0.696 on
 /// nanobowl and 0.654 on ns90k.
@@ -16,6 +21,11 @@ pub const BVH_NODES_PER_PRIM: f64 = 0.70;
 /// 0.122 (ns90k), so one constant is within ±25 % of the wide BVH (a fifth of the model's
 /// bytes); the total is held within 10 % by `crates/scene/tests/build.rs`.
 pub const WIDE_NODES_PER_PRIM: f64 = 0.10;
+/// Bytes per pixel of the frame `render` draws: the packed RGBA8 framebuffer (the tile
+/// driver keeps its sums per tile; the f32 `render::Accum` of progressive front ends, 12 B
+/// more per pixel, is not counted). Measured: `render 2r9r-1b.xyz` (1,284 atoms) peaks 12.6 MB
+/// higher at 2048² than at 1024² (4.1 B per added pixel, PNG encoding included).
+pub const FRAME_BYTES_PER_PIXEL: u64 = 4;
 /// Bytes of a binary BVH node.
 const NODE_BYTES: u64 = 32;
 /// Bytes of an 8-wide node.
@@ -44,10 +54,17 @@ pub struct MemoryEstimate {
     pub macrocells: u64,
     /// Light volume (1 B/point).
     pub light_volume: u64,
-    /// Frame: packed pixels (4 B) + f32 RGB accumulation (12 B) per pixel.
+    /// Per-atom scratch the scene keeps between frames: radius (4 B) and colour (4 B) with a
+    /// model, the density radii (4 B) for a volume alone.
+    pub scratch: u64,
+    /// Frame: packed RGBA8 pixels, 4 B per pixel ([`FRAME_BYTES_PER_PIXEL`]).
     pub framebuffer: u64,
     /// Lattice points of the density volume along x, y, z (`None`: no volume).
     pub volume_dims: Option<[usize; 3]>,
+    /// Peak resident set of a `render` process building and drawing this scene (estimated
+    /// by [`MemoryEstimate::new`]; zero from [`MemoryEstimate::measured`], which sees only the
+    /// built scene at rest).
+    pub peak: Peak,
 }
 
 impl MemoryEstimate {
@@ -62,8 +79,18 @@ impl MemoryEstimate {
             atoms: m.memory_bytes() as u64,
             ..MemoryEstimate::default()
         };
+        let all_bonds = bonds;
+        let mut counts = peak::Counts {
+            atoms: m.len() as u64,
+            ..Default::default()
+        };
         if let Some(ms) = &settings.model {
             let (bonds, prims) = model_prim_count(m.len(), bonds, ms);
+            counts.bonds = all_bonds as u64;
+            counts.sticks = bonds as u64;
+            counts.prims = prims as u64;
+            counts.nodes = (prims as f64 * BVH_NODES_PER_PRIM).ceil() as u64;
+            counts.auto_bonds = settings.bonds.source == crate::BondSource::Auto;
             e.bonds = bonds as u64 * 8;
             e.geometry = m.len() as u64 * 20 + bonds as u64 * 8 + prims as u64 * 8;
             let nodes = (prims as f64 * BVH_NODES_PER_PRIM).ceil() as u64;
@@ -74,6 +101,10 @@ impl MemoryEstimate {
         }
         if let Some(vs) = &settings.volume {
             let grid = density_grid(m, vs)?;
+            counts.slab_entries = slab_entries(m, &grid);
+            counts.density_scratch = volume::estimate_bytes(&grid, vs.format)
+                .saturating_sub(grid.voxel_count() * vs.format.bytes_per_voxel() + 4)
+                .saturating_sub(macrocell_count(&grid) * 8);
             e.volume = grid.voxel_count() * vs.format.bytes_per_voxel() + 4;
             e.volume_dims = Some(grid.dims);
             e.macrocells = macrocell_count(&grid) * 8;
@@ -86,8 +117,10 @@ impl MemoryEstimate {
             }
         }
         if let Some((w, h)) = settings.frame {
-            e.framebuffer = w as u64 * h as u64 * 16;
+            e.framebuffer = w as u64 * h as u64 * FRAME_BYTES_PER_PIXEL;
         }
+        e.scratch = scratch_bytes(m.len(), settings);
+        e.peak = Peak::new(&e, &counts);
         Ok(e)
     }
 
@@ -117,18 +150,28 @@ impl MemoryEstimate {
             e.light_volume = lv.bytes();
         }
         if let Some((w, h)) = scene.settings.frame {
-            e.framebuffer = w as u64 * h as u64 * 16;
+            e.framebuffer = w as u64 * h as u64 * FRAME_BYTES_PER_PIXEL;
         }
+        e.scratch = scene.scratch_bytes();
         e
     }
 
-    /// Sum of the components (bytes).
+    /// Sum of the components: the scene at rest, while a frame is drawn (bytes).
     pub fn total(&self) -> u64 {
         self.components().iter().map(|(_, b)| b).sum()
     }
 
+    /// Estimated peak resident set of a `render` process for this scene (bytes): the
+    /// process baseline, the bytes alive at the worst moment of the build (often the BVH
+    /// build, not the scene at rest) and what the allocator keeps of blocks freed before it
+    /// ([`Peak`]). Never below [`MemoryEstimate::total`]. This is the figure `bnsview info`
+    /// prints and [`crate::Scene::build`] checks against the memory budget.
+    pub fn peak_bytes(&self) -> u64 {
+        self.peak.bytes().max(self.total())
+    }
+
     /// `(name, bytes)` of every component, in a fixed order.
-    pub fn components(&self) -> [(&'static str, u64); 9] {
+    pub fn components(&self) -> [(&'static str, u64); 10] {
         [
             ("atoms", self.atoms),
             ("bonds", self.bonds),
@@ -138,6 +181,7 @@ impl MemoryEstimate {
             ("volume", self.volume),
             ("macrocells", self.macrocells),
             ("light_volume", self.light_volume),
+            ("scratch", self.scratch),
             ("framebuffer", self.framebuffer),
         ]
     }
@@ -151,6 +195,37 @@ impl MemoryEstimate {
             .collect::<Vec<_>>()
             .join(", ")
     }
+}
+
+/// Bytes of the per-atom scratch [`Scene`] keeps (radius and colour with a model, else the
+/// density radii of a volume).
+fn scratch_bytes(atoms: usize, settings: &SceneSettings) -> u64 {
+    let per_atom = if settings.model.is_some() {
+        8
+    } else if settings.volume.is_some() {
+        4
+    } else {
+        0
+    };
+    atoms as u64 * per_atom
+}
+
+/// Lattice planes per z-slab of the density builder (`volume::grid`'s `SLAB`).
+const DENSITY_SLAB: f64 = 4.0;
+
+/// Entries of the density builder's per-slab atom lists: an atom is listed in every slab of
+/// [`DENSITY_SLAB`] planes its support (√2·r + one voxel) reaches, on average
+/// `1 + 2·reach / (spacing · SLAB)` slabs.
+fn slab_entries(m: &Molecule, g: &Grid) -> u64 {
+    m.element_counts()
+        .into_iter()
+        .map(|(z, count)| {
+            let reach = std::f64::consts::SQRT_2 * elements::element(z).covalent_radius as f64
+                + g.spacing as f64;
+            let slabs = 1.0 + 2.0 * reach / (g.spacing as f64 * DENSITY_SLAB);
+            (count as f64 * slabs).ceil() as u64
+        })
+        .sum()
 }
 
 /// Macrocells of a grid, as [`volume::Macrocells::build`] lays them out.

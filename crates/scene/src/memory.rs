@@ -57,7 +57,7 @@ pub struct MemoryEstimate {
     /// Per-atom scratch the scene keeps between frames: radius (4 B) and colour (4 B) with a
     /// model, the density radii (4 B) for a volume alone.
     pub scratch: u64,
-    /// Frame: packed RGBA8 pixels, 4 B per pixel ([`FRAME_BYTES_PER_PIXEL`]).
+    /// Frame: packed RGBA8 pixels, 4 B per pixel.
     pub framebuffer: u64,
     /// Lattice points of the density volume along x, y, z (`None`: no volume).
     pub volume_dims: Option<[usize; 3]>,

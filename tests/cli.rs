@@ -619,3 +619,52 @@ fn generate_writes_a_trajectory_of_the_frames_asked_for() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn render_help_is_grouped_under_headings() {
+    let (ok, out, err) = run(bnsview().args(["render", "--help"]));
+    assert!(ok, "{err}");
+    let headings = [
+        "Input and bonds:",
+        "Output:",
+        "Camera:",
+        "Style and colour:",
+        "Volume:",
+        "Lighting:",
+        "Path tracing:",
+        "Performance:",
+    ];
+    let at: Vec<usize> = headings
+        .iter()
+        .map(|h| {
+            out.find(&format!("\n{h}\n"))
+                .unwrap_or_else(|| panic!("no heading {h:?} in\n{out}"))
+        })
+        .collect();
+    // The heading a flag is listed under: the last heading before it.
+    let heading_of = |flag: &str| {
+        // A flag's own line: indented, then a space (its value) or the end of the line.
+        let f = [format!("  {flag} "), format!("  {flag}\n")]
+            .iter()
+            .filter_map(|p| out.find(p.as_str()))
+            .min()
+            .unwrap_or_else(|| panic!("no {flag} in\n{out}"));
+        headings[at
+            .iter()
+            .rposition(|&h| h < f)
+            .expect("a flag before every heading")]
+    };
+    for (flag, want) in [
+        ("--scene", "Input and bonds:"),
+        ("--pbc", "Input and bonds:"),
+        ("--frames", "Output:"),
+        ("--orbit", "Camera:"),
+        ("--legend", "Style and colour:"),
+        ("--tf", "Volume:"),
+        ("--shadows", "Lighting:"),
+        ("--spp", "Path tracing:"),
+        ("--threads", "Performance:"),
+    ] {
+        assert_eq!(heading_of(flag), want, "{flag}");
+    }
+}

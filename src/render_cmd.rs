@@ -84,8 +84,18 @@ fn parse_point(s: &str) -> Result<[f32; 3], String> {
     vec3(s).ok_or_else(|| format!("{s:?}: expected a point x,y,z in Å (three finite numbers)"))
 }
 
+/// Which frames of a series the camera is fitted to.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitFrames {
+    /// The first frame rendered.
+    First,
+    /// Every frame rendered.
+    All,
+}
+
 /// Arguments of `bnsview render`.
 #[derive(Args, Debug)]
+#[command(group(clap::ArgGroup::new("series").args(["frames", "follow"]).multiple(true)))]
 pub struct RenderArgs {
     #[command(flatten)]
     pub input: InputArgs,
@@ -104,12 +114,29 @@ pub struct RenderArgs {
         conflicts_with = "frame"
     )]
     pub frames: Option<series::FrameRange>,
-    /// With --frames: build each frame after the previous one is rendered instead of in the
-    /// background (for comparison).
-    #[arg(help_heading = "Output", long, requires = "frames")]
+    /// Follow a dump (XYZ, .gro or LAMMPS dump, uncompressed) that a simulation is still
+    /// writing: render every frame (of --frames, default all) as soon as it is complete, until
+    /// Ctrl-C or --max-frames. Works on NFS (polls the file size).
+    #[arg(help_heading = "Output", long, conflicts_with = "frame")]
+    pub follow: bool,
+    /// With --follow: stop after this many rendered frames.
+    #[arg(help_heading = "Output", long, value_name = "N", requires = "follow")]
+    pub max_frames: Option<usize>,
+    /// With --follow: seconds between two looks at the file while waiting for a frame.
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.5,
+        requires = "follow"
+    )]
+    pub poll: f64,
+    /// With --frames or --follow: build each frame after the previous one is rendered instead
+    /// of in the background (for comparison).
+    #[arg(help_heading = "Output", long, requires = "series")]
     pub no_pipeline: bool,
-    /// With --frames -o movie.gif: frames per second of the GIF.
-    #[arg(help_heading = "Output", long, default_value_t = series::DEFAULT_GIF_FPS, requires = "frames")]
+    /// With --frames or --follow and -o movie.gif: frames per second of the GIF.
+    #[arg(help_heading = "Output", long, default_value_t = series::DEFAULT_GIF_FPS, requires = "series")]
     pub gif_fps: f32,
     /// Overwrite the output if it exists.
     #[arg(help_heading = "Output", short, long)]
@@ -133,6 +160,10 @@ pub struct RenderArgs {
     /// Explicit camera: `eye=x,y,z:at=x,y,z[:up=x,y,z][:fov=deg][:ortho=height_Å]`.
     #[arg(help_heading = "Camera", long)]
     pub camera: Option<String>,
+    /// With --frames: fit the camera to the first frame, or to all the frames rendered (the
+    /// file is read twice: once to find where the atoms go, once to render).
+    #[arg(help_heading = "Camera", long, value_enum, default_value_t = FitFrames::First, requires = "frames", conflicts_with = "camera")]
+    pub fit: FitFrames,
     /// Vertical field of view of the presets (degrees).
     #[arg(help_heading = "Camera", long, default_value_t = 45.0)]
     pub fov: f32,
@@ -262,7 +293,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     if input.file.is_none() && input.scene.is_none() {
         input.scene = Some(molecule::scenes::SceneName::Nanobowl);
     }
-    if args.frames.is_some() {
+    if args.frames.is_some() || args.follow {
         return crate::series_cmd::run(&args, &input, isa);
     }
     let output = args.output.clone().unwrap_or_else(|| {

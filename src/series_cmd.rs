@@ -3,25 +3,33 @@
 //! background).
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use molecule::read::Follower;
 use render::Camera;
-use series::{render_series, CameraChoice, OutputKind, SeriesSettings, Sink};
+use series::{
+    follow_series, render_series, CameraChoice, FollowSettings, FrameRange, OutputKind,
+    SeriesSettings, Sink,
+};
 use spmd::Isa;
 use volume::TransferFunction;
 
 use crate::input::InputArgs;
-use crate::render_cmd::{background, render_settings, scene_settings, Mode, RenderArgs};
+use crate::render_cmd::{background, render_settings, scene_settings, FitFrames, Mode, RenderArgs};
 
 /// Renders `args.frames` of the input file.
 pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
-    let Some(frames) = args.frames else {
-        bail!("internal: series without --frames");
-    };
+    let frames = args.frames.unwrap_or(FrameRange::ALL);
     let Some(path) = input.file.clone() else {
-        bail!("--frames renders the frames of a trajectory file; built-in scenes have one frame");
+        bail!("--frames and --follow render the frames of a trajectory file; built-in scenes have one frame");
     };
+    if args.follow && !(args.poll.is_finite() && (0.01..=3600.0).contains(&args.poll)) {
+        bail!("--poll {}: expected 0.01 to 3600 seconds", args.poll);
+    }
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = path
             .file_name()
@@ -47,10 +55,18 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
                 (orbit.azimuth_deg, orbit.elevation_deg) = (o.azimuth_deg, o.elevation_deg);
             }
             orbit.zoom = args.zoom;
-            CameraChoice::Fit {
-                view,
-                orbit,
-                fov_deg: args.fov,
+            let fov_deg = args.fov;
+            match args.fit {
+                FitFrames::First => CameraChoice::Fit {
+                    view,
+                    orbit,
+                    fov_deg,
+                },
+                FitFrames::All => CameraChoice::FitAll {
+                    view,
+                    orbit,
+                    fov_deg,
+                },
             }
         }
     };
@@ -73,7 +89,13 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         pipelined: !args.no_pipeline,
         isa,
     };
-    let mut traj = input.open_trajectory(&path)?;
+    // Open the input before the output, so a bad input leaves no empty movie behind.
+    let mut source = if args.follow {
+        let opts = input.read_options()?;
+        Source::Follow(Follower::new(&path, &opts)?)
+    } else {
+        Source::File(input.open_trajectory(&path)?)
+    };
     let mut sink = Sink::open(&kind, args.force, args.gif_fps)?;
     let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     if let Ok(style) =
@@ -83,9 +105,29 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
     }
     pb.enable_steady_tick(std::time::Duration::from_millis(500));
     let verbose = args.verbose;
-    let report = render_series(&mut traj, &settings, &mut sink, &mut |r| {
+    let follow = args.follow.then(|| FollowSettings {
+        poll: Duration::from_secs_f64(args.poll),
+        max_frames: args.max_frames,
+        stop: Arc::new(AtomicBool::new(false)),
+    });
+    if let Some(f) = &follow {
+        stop_on_ctrl_c(f.stop.clone())?;
+        pb.set_message(format!(
+            "following {}, waiting for a complete frame (Ctrl-C to stop)",
+            path.display()
+        ));
+    }
+    let mut on_frame = |r: &series::FrameReport| {
         pb.inc(1);
-        pb.set_message(format!("frame {} → {}", r.frame, r.path.display()));
+        pb.set_message(if follow.is_some() {
+            format!(
+                "frame {} → {}; waiting for the next frame (Ctrl-C to stop)",
+                r.frame,
+                r.path.display()
+            )
+        } else {
+            format!("frame {} → {}", r.frame, r.path.display())
+        });
         if verbose {
             pb.suspend(|| {
                 eprintln!(
@@ -94,11 +136,26 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
                 )
             });
         }
-    })
+    };
+    let report = match (&mut source, &follow) {
+        (Source::Follow(f), Some(fs)) => follow_series(f, &settings, fs, &mut sink, &mut on_frame),
+        (Source::File(t), _) => render_series(t, &settings, &mut sink, &mut on_frame),
+        (Source::Follow(_), None) => bail!("internal: following without settings"),
+    }
     .with_context(|| format!("rendering the frames of {}", path.display()))?;
     pb.finish_and_clear();
-    for warning in traj.warnings() {
+    let (warnings, decoded) = match &mut source {
+        Source::Follow(f) => (f.warnings().to_vec(), None),
+        Source::File(t) => (t.warnings().to_vec(), Some(t.decoded_bytes())),
+    };
+    for warning in warnings {
         eprintln!("warning: {warning}");
+    }
+    if follow
+        .as_ref()
+        .is_some_and(|f| f.stop.load(Ordering::Relaxed))
+    {
+        eprintln!("stopped by Ctrl-C");
     }
     if verbose {
         eprintln!(
@@ -117,14 +174,14 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         }
         let hidden = (report.build_s - report.wait_s).max(0.0);
         eprintln!(
-            "series:  {} frames in {:.2} s ({:.2} frames/s); read+build {:.2} s, of which {:.2} s hidden behind rendering{}; {} MB read from {}",
+            "series:  {} frames in {:.2} s ({:.2} frames/s); read+build {:.2} s, of which {:.2} s hidden behind rendering{}; {} MB decoded from {}",
             report.frames,
             report.wall_s,
             report.frames as f64 / report.wall_s.max(1e-9),
             report.build_s,
             hidden,
             if settings.pipelined { "" } else { " (--no-pipeline)" },
-            traj.decoded_bytes() / 1_000_000,
+            decoded.map_or("(followed)".into(), |b| (b / 1_000_000).to_string()),
             path.display()
         );
     }
@@ -136,4 +193,24 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         args.mode.name()
     );
     Ok(())
+}
+
+/// Where the frames come from.
+enum Source {
+    /// A finished file, read once.
+    File(molecule::read::Trajectory),
+    /// A file still being written.
+    Follow(Follower),
+}
+
+/// Sets `stop` on the first Ctrl-C (the series finishes the frame it renders and completes
+/// its output); a second Ctrl-C exits at once.
+fn stop_on_ctrl_c(stop: Arc<AtomicBool>) -> Result<()> {
+    ctrlc::set_handler(move || {
+        if stop.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!("\nCtrl-C: finishing the current frame (press again to quit at once)");
+    })
+    .context("installing the Ctrl-C handler")
 }

@@ -1,16 +1,13 @@
 //! `bnsview bench` on tiny configurations: the JSON it writes is complete and consistent with
 //! what was asked for. No timing assertions.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
+use common::bnsview;
 use serde_json::Value;
-
-fn bnsview() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_bnsview"));
-    c.env_remove("BNS_ISA").env_remove("BNS_CPU_LIMIT");
-    c
-}
 
 fn tmp(name: &str) -> PathBuf {
     let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))

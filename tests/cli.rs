@@ -1,21 +1,10 @@
 //! The CLI's ISA handling, run as a user would.
 
+mod common;
+
 use std::process::Command;
 
-fn bnsview() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_bnsview"));
-    c.env_remove("BNS_ISA").env_remove("BNS_CPU_LIMIT");
-    c
-}
-
-fn run(c: &mut Command) -> (bool, String, String) {
-    let out = c.output().expect("run bnsview");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::{bnsview, run, sample, scratch};
 
 #[test]
 fn version_reports_the_forced_isa() {
@@ -78,13 +67,6 @@ fn unsupported_or_unknown_isa_is_a_clear_error() {
 }
 
 /// A fresh directory for one test's files.
-fn scratch(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("bnsview-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 #[test]
 fn render_writes_a_png_of_the_scene_and_never_overwrites_unasked() {
     let d = scratch("render");
@@ -409,8 +391,7 @@ fn pbc_draws_half_sticks_and_cell_draws_the_box() {
 #[test]
 fn colour_range_is_printed_and_obeyed_and_the_legend_sits_at_the_right() {
     let d = scratch("legend");
-    let dump = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/mass_q_elem.lammpstrj");
+    let dump = sample("mass_q_elem.lammpstrj");
     let render = |name: &str, extra: &[&str]| {
         let out = d.join(name);
         let (ok, _, err) = run(bnsview()
@@ -466,8 +447,7 @@ fn colour_range_is_printed_and_obeyed_and_the_legend_sits_at_the_right() {
 #[test]
 fn frames_of_a_trajectory_equal_single_frames_with_the_printed_camera_and_range() {
     let d = scratch("frames");
-    let dump = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/spce_water.lammpstrj.gz");
+    let dump = sample("spce_water.lammpstrj.gz");
     let common = ["--types", "1=O,2=H", "--size", "64x48", "--color", "id"];
     let (ok, _, err) = run(bnsview()
         .arg("render")

@@ -20,6 +20,31 @@ pub struct Sphere {
     pub radius: f32,
 }
 
+impl Sphere {
+    /// The smallest sphere holding both `self` and `o` (Å).
+    pub fn union(self, o: Sphere) -> Sphere {
+        let d = (0..3)
+            .map(|k| ((o.center[k] - self.center[k]) as f64).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let (r1, r2) = (self.radius as f64, o.radius as f64);
+        if d + r2 <= r1 {
+            return self;
+        }
+        if d + r1 <= r2 {
+            return o;
+        }
+        let r = (d + r1 + r2) * 0.5;
+        let t = (r - r1) / d;
+        Sphere {
+            center: core::array::from_fn(|k| {
+                (self.center[k] as f64 + (o.center[k] - self.center[k]) as f64 * t) as f32
+            }),
+            radius: r as f32,
+        }
+    }
+}
+
 /// The sphere every command fits its camera to: the model's ([`Model::center`],
 /// [`Model::radius`]: centre of the BVH box, radius to the farthest ball surface) when there is
 /// a model, else the atom centres' (centre of their box) grown by [`ATOM_SPHERE_PAD`].

@@ -8,6 +8,20 @@ pub enum SeriesError {
     /// Reading a frame failed.
     #[error(transparent)]
     Read(#[from] molecule::read::ReadError),
+    /// Following a growing file failed (it shrank, was replaced, or cannot be followed).
+    #[error(transparent)]
+    Follow(#[from] molecule::read::FollowError),
+    /// A followed file had no complete frame in the range when the series stopped.
+    #[error("{path}: stopped before a frame to render was complete ({frames} complete frame(s) in the file)")]
+    NothingFollowed {
+        /// The file.
+        path: String,
+        /// Complete frames seen.
+        frames: usize,
+    },
+    /// `--fit all` asked of a followed file (its frames are not all there yet).
+    #[error("--fit all needs every frame before the first is rendered, which a followed file does not have; the camera follows the first frame, or pass --camera (e.g. printed by -v on the finished file)")]
+    FitAllFollow,
     /// Building a frame's scene failed.
     #[error("frame {frame}: {error}")]
     Scene {

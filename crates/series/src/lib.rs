@@ -2,17 +2,21 @@
 //! pass through the file, with the next frame read and its scene (bonds, BVH, volume) built
 //! on a background thread while the current one renders. The camera and the colour and
 //! density ranges are fixed by the first frame, so a movie does not jump or flicker. Frames go
-//! to numbered PNG/JPEG files or an animated GIF ([`Sink`]).
+//! to numbered PNG/JPEG files, an animated GIF or a video ([`Sink`]). A file a simulation is
+//! still writing can be followed, each frame rendered when it is complete ([`follow_series`]).
 //!
 //! Units: positions in Ångström (Å), times in seconds.
 #![warn(missing_docs)]
 
 mod error;
+mod fit_all;
+mod follow;
 mod output;
 mod range;
 mod run;
 
 pub use error::SeriesError;
+pub use follow::{follow_series, FollowSettings};
 pub use output::{expand, OutputKind, Sink, DEFAULT_GIF_FPS};
 pub use range::{FrameRange, FrameRangeError};
 pub use run::{render_series, CameraChoice, FrameReport, SeriesReport, SeriesSettings};

@@ -11,6 +11,7 @@ use render::{draw_legend, render_frame, Camera, FrameInputs, Framebuffer, Legend
 use scene::{ColorBy, Orbit, Scene, SceneSettings, View};
 use spmd::Isa;
 
+use crate::fit_all::sphere_of_frames;
 use crate::{FrameRange, SeriesError, Sink};
 
 /// How the camera of the series is chosen.
@@ -18,6 +19,16 @@ use crate::{FrameRange, SeriesError, Sink};
 pub enum CameraChoice {
     /// This camera for every frame.
     Fixed(Camera),
+    /// Fitted to the sphere holding every frame to be rendered (a first pass through the
+    /// file finds it; not possible when following a file).
+    FitAll {
+        /// Distance preset.
+        view: View,
+        /// Direction and zoom around the centre.
+        orbit: Orbit,
+        /// Vertical field of view (degrees).
+        fov_deg: f32,
+    },
     /// Fitted once, to the first rendered frame's bounding sphere.
     Fit {
         /// Distance preset.
@@ -87,6 +98,8 @@ pub struct SeriesReport {
     pub wait_s: f64,
     /// The camera used.
     pub camera: Option<Camera>,
+    /// The sphere the camera was fitted to (Å; `None` for a fixed camera).
+    pub fitted_to: Option<scene::Sphere>,
     /// The column colour range used, when colouring by a column.
     pub color_range: Option<(f32, f32)>,
     /// The density mapped to the transfer function's top, when there is a volume.
@@ -102,38 +115,62 @@ struct Built {
     build_s: f64,
 }
 
-/// Reads on to the next frame in `range` (skipping the others without building them).
-fn next_molecule(
-    traj: &mut Trajectory,
-    range: &FrameRange,
-    next: &mut usize,
-) -> Result<Option<(usize, Molecule)>, SeriesError> {
-    loop {
-        if range.end.is_some_and(|e| *next >= e) {
-            return Ok(None);
+/// Where the frames of a series come from: a file read once from its start, or a growing
+/// file followed as it is written.
+pub(crate) trait Frames: Send {
+    /// The next frame to render and its index in the file; `None` when the series is over.
+    fn next_frame(&mut self) -> Result<Option<(usize, Molecule)>, SeriesError>;
+    /// The error when the series ends before its first frame.
+    fn none_error(&self) -> SeriesError;
+    /// Whether a GIF or video holding the frames so far is completed, not removed, when the
+    /// series stops on an error (a followed run: the frames already shown stay).
+    fn keep_on_error(&self) -> bool {
+        false
+    }
+}
+
+/// The frames of `range` in a trajectory, read on from its current position.
+struct Ranged<'a> {
+    traj: &'a mut Trajectory,
+    range: FrameRange,
+    /// Index of the next frame the trajectory yields.
+    next: usize,
+}
+
+impl Frames for Ranged<'_> {
+    fn next_frame(&mut self) -> Result<Option<(usize, Molecule)>, SeriesError> {
+        loop {
+            if self.range.end.is_some_and(|e| self.next >= e) {
+                return Ok(None);
+            }
+            let k = self.next;
+            let Some(m) = self.traj.next() else {
+                return Ok(None);
+            };
+            let m = m?;
+            self.next += 1;
+            if self.range.contains(k) {
+                return Ok(Some((k, m)));
+            }
         }
-        let k = *next;
-        let Some(m) = traj.next() else {
-            return Ok(None);
-        };
-        let m = m?;
-        *next += 1;
-        if range.contains(k) {
-            return Ok(Some((k, m)));
+    }
+
+    fn none_error(&self) -> SeriesError {
+        SeriesError::NoFrames {
+            range: self.range.to_string(),
+            count: self.next,
         }
     }
 }
 
-/// Reads and builds the next frame in range with `settings`.
+/// Reads and builds the next frame of `frames` with `settings`.
 fn read_and_build(
-    traj: &mut Trajectory,
-    range: &FrameRange,
-    next: &mut usize,
+    frames: &mut dyn Frames,
     settings: &SceneSettings,
     isa: Isa,
 ) -> Result<Option<Built>, SeriesError> {
     let t = Instant::now();
-    let Some((frame, m)) = next_molecule(traj, range, next)? else {
+    let Some((frame, m)) = frames.next_frame()? else {
         return Ok(None);
     };
     let read_s = t.elapsed().as_secs_f64();
@@ -150,7 +187,8 @@ fn read_and_build(
 }
 
 /// Renders the frames `s.frames` of `traj` (read from its current position onwards, once)
-/// to `sink`, calling `on_frame` after each one is written.
+/// to `sink`, calling `on_frame` after each one is written. With [`CameraChoice::FitAll`] the
+/// file is read once more first (from its start) to find the sphere holding every frame.
 /// On an error a GIF or video being written is removed ([`Sink::abandon`]).
 pub fn render_series(
     traj: &mut Trajectory,
@@ -158,15 +196,60 @@ pub fn render_series(
     sink: &mut Sink,
     on_frame: &mut dyn FnMut(&FrameReport),
 ) -> Result<SeriesReport, SeriesError> {
-    let r = run_series(traj, s, sink, on_frame);
+    let fitted;
+    let mut fitted_to = None;
+    let s = match s.camera {
+        CameraChoice::FitAll {
+            view,
+            orbit,
+            fov_deg,
+        } => {
+            let sphere = traj
+                .reopen()
+                .map_err(SeriesError::from)
+                .and_then(|mut t| sphere_of_frames(&mut t, &s.frames, &s.scene));
+            let sphere = sphere.inspect_err(|_| sink.abandon())?;
+            fitted_to = Some(sphere);
+            let (w, h) = s.size;
+            let camera = Camera::fit(view, sphere, fov_deg, w as f32 / h as f32, orbit);
+            fitted = SeriesSettings {
+                camera: CameraChoice::Fixed(camera),
+                ..s.clone()
+            };
+            &fitted
+        }
+        _ => s,
+    };
+    let mut frames = Ranged {
+        traj,
+        range: s.frames,
+        next: 0,
+    };
+    let mut report = run_frames(&mut frames, s, sink, on_frame)?;
+    report.fitted_to = report.fitted_to.or(fitted_to);
+    Ok(report)
+}
+
+/// [`run_series`], removing a GIF or video being written on an error.
+pub(crate) fn run_frames(
+    frames: &mut dyn Frames,
+    s: &SeriesSettings,
+    sink: &mut Sink,
+    on_frame: &mut dyn FnMut(&FrameReport),
+) -> Result<SeriesReport, SeriesError> {
+    let r = run_series(frames, s, sink, on_frame);
     if r.is_err() {
-        sink.abandon();
+        if frames.keep_on_error() {
+            sink.finish().ok();
+        } else {
+            sink.abandon();
+        }
     }
     r
 }
 
 fn run_series(
-    traj: &mut Trajectory,
+    frames: &mut dyn Frames,
     s: &SeriesSettings,
     sink: &mut Sink,
     on_frame: &mut dyn FnMut(&FrameReport),
@@ -174,18 +257,15 @@ fn run_series(
     s.render
         .validate(s.scene.model.is_some(), s.scene.volume.is_some())?;
     let wall = Instant::now();
-    let mut next = 0usize;
     let mut settings = s.scene.clone();
     // The first frame fixes the camera and the ranges.
-    let Some(first) = read_and_build(traj, &s.frames, &mut next, &settings, s.isa)? else {
-        return Err(SeriesError::NoFrames {
-            range: s.frames.to_string(),
-            count: next,
-        });
+    let Some(first) = read_and_build(frames, &settings, s.isa)? else {
+        return Err(frames.none_error());
     };
     let (w, h) = s.size;
     let camera = match s.camera {
         CameraChoice::Fixed(c) => c,
+        CameraChoice::FitAll { .. } => return Err(SeriesError::FitAllFollow),
         CameraChoice::Fit {
             view,
             orbit,
@@ -210,6 +290,7 @@ fn run_series(
     }
     let mut report = SeriesReport {
         camera: Some(camera),
+        fitted_to: matches!(s.camera, CameraChoice::Fit { .. }).then_some(first.scene.sphere),
         color_range,
         density_max,
         ..SeriesReport::default()
@@ -265,7 +346,7 @@ fn run_series(
     let first_wait = first.read_s + first.build_s;
     if !s.pipelined {
         render_one(first, first_wait)?;
-        while let Some(b) = read_and_build(traj, &s.frames, &mut next, &settings, s.isa)? {
+        while let Some(b) = read_and_build(frames, &settings, s.isa)? {
             let wait = b.read_s + b.build_s;
             render_one(b, wait)?;
         }
@@ -274,12 +355,11 @@ fn run_series(
         // takes it, so at most two scenes are alive (k rendering, k+1 waiting).
         let (tx, rx) = sync_channel::<Result<Built, SeriesError>>(0);
         let settings = &settings;
-        let frames = &s.frames;
         std::thread::scope(|scope| -> Result<(), SeriesError> {
             // Owned here, so an error return drops it and a builder blocked on `send` exits.
             let rx = rx;
             scope.spawn(move || loop {
-                match read_and_build(traj, frames, &mut next, settings, s.isa) {
+                match read_and_build(frames, settings, s.isa) {
                     Ok(Some(b)) => {
                         if tx.send(Ok(b)).is_err() {
                             return;

@@ -2,112 +2,15 @@
 //! same bytes), the one pass through a gzip dump (decoded bytes counted), the GIF's frame
 //! count, and the refusals.
 
+mod common;
+
 use std::io::Read;
-use std::path::{Path, PathBuf};
 
+use common::{by_element, data, png, scratch, settings, water_with_height};
 use molecule::read::{open, ReadOptions};
-use render::{render_frame, FrameInputs, Framebuffer, RenderSettings};
-use scene::{ColorBy, Colormap, ModelSettings, Orbit, Scene, SceneSettings, View};
-use series::{
-    render_series, CameraChoice, FrameRange, OutputKind, SeriesError, SeriesSettings, Sink,
-};
-use spmd::Isa;
-
-fn data(name: &str) -> PathBuf {
-    let crate_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    crate_dir
-        .ancestors()
-        .map(|a| a.join("shared/data").join(name))
-        .find(|d| d.exists())
-        .unwrap_or_else(|| panic!("no shared/data/{name} above {}", crate_dir.display()))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bnsview-series-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// The first `frames` frames of the water dump rewritten with a column `h` = the atom's
-/// height z (Å), which changes from frame to frame, as a plain dump in `dir`.
-fn water_with_height(dir: &Path, frames: usize) -> PathBuf {
-    use std::fmt::Write;
-    let mut t = open(&data("spce_water.lammpstrj.gz"), &ReadOptions::default()).unwrap();
-    let mut s = String::new();
-    for k in 0..frames {
-        let m = t.read_frame(k).unwrap();
-        let c = m.cell.unwrap();
-        let hi = [0, 1, 2].map(|a| c.origin[a] + c.edges[a][a]);
-        write!(
-            s,
-            "ITEM: TIMESTEP\n{k}\nITEM: NUMBER OF ATOMS\n{}\n",
-            m.len()
-        )
-        .unwrap();
-        s.push_str("ITEM: BOX BOUNDS pp pp pp\n");
-        for (lo, hi) in c.origin.iter().zip(hi) {
-            writeln!(s, "{lo} {hi}").unwrap();
-        }
-        s.push_str("ITEM: ATOMS id type x y z h\n");
-        for i in 0..m.len() {
-            let ty = if m.elements[i] == 8 { 1 } else { 2 };
-            writeln!(
-                s,
-                "{} {ty} {} {} {} {}",
-                i + 1,
-                m.x[i],
-                m.y[i],
-                m.z[i],
-                m.z[i]
-            )
-            .unwrap();
-        }
-    }
-    let p = dir.join("water_h.lammpstrj");
-    std::fs::write(&p, s).unwrap();
-    p
-}
-
-/// Water coloured by the height column `h` of [`water_with_height`].
-fn settings(frames: FrameRange, pipelined: bool) -> SeriesSettings {
-    SeriesSettings {
-        frames,
-        scene: SceneSettings {
-            model: Some(ModelSettings {
-                color: ColorBy::Column {
-                    name: "h".into(),
-                    colormap: Colormap::Viridis,
-                    range: None,
-                },
-                ..ModelSettings::default()
-            }),
-            budget_bytes: Some(u64::MAX),
-            ..SceneSettings::default()
-        },
-        render: RenderSettings::default(),
-        size: (64, 48),
-        camera: CameraChoice::Fit {
-            view: View::Far,
-            orbit: Orbit::default(),
-            fov_deg: 45.0,
-        },
-        legend_ink: None,
-        pipelined,
-        isa: Isa::detect(),
-    }
-}
-
-/// [`settings`] with CPK colours (for the plain water dump), pipelined.
-fn by_element(frames: FrameRange) -> SeriesSettings {
-    let mut s = settings(frames, true);
-    s.scene.model.as_mut().unwrap().color = ColorBy::Element;
-    s
-}
-
-fn png(p: &Path) -> Vec<u8> {
-    image::open(p).unwrap().to_rgba8().into_raw()
-}
+use render::{render_frame, FrameInputs, Framebuffer};
+use scene::{ColorBy, Scene};
+use series::{render_series, CameraChoice, FrameRange, OutputKind, SeriesError, Sink};
 
 #[test]
 fn every_frame_equals_that_frame_rendered_alone_with_the_printed_camera_and_range() {
@@ -204,15 +107,14 @@ fn bad_outputs_and_empty_ranges_are_refused() {
     std::fs::write(d.join("f_00000.png"), b"mine").unwrap();
     let pattern = d.join("f_%05d.png");
     let dump = data("spce_water.lammpstrj.gz");
-    let mut traj = open(&dump, &ReadOptions::default()).unwrap();
-    let mut sink = Sink::open(&OutputKind::from_path(&pattern).unwrap(), false, 10.0).unwrap();
-    let e = render_series(
-        &mut traj,
-        &by_element("0:1".parse().unwrap()),
-        &mut sink,
-        &mut |_| {},
-    )
-    .unwrap_err();
+    // The water dump's frames `range` to `out`; the error.
+    let fails = |range: &str, out: &std::path::Path| {
+        let mut traj = open(&dump, &ReadOptions::default()).unwrap();
+        let mut sink = Sink::open(&OutputKind::from_path(out).unwrap(), false, 10.0).unwrap();
+        let s = by_element(range.parse().unwrap());
+        render_series(&mut traj, &s, &mut sink, &mut |_| {}).unwrap_err()
+    };
+    let e = fails("0:1", &pattern);
     assert!(matches!(e, SeriesError::Exists(_)), "{e}");
     assert_eq!(std::fs::read(d.join("f_00000.png")).unwrap(), b"mine");
     // A GIF cut short by an error is removed, not left half written.
@@ -223,14 +125,82 @@ fn bad_outputs_and_empty_ranges_are_refused() {
     assert!(render_series(&mut traj, &no_column, &mut sink, &mut |_| {}).is_err());
     assert!(!gif.exists());
     // A range past the end of the file.
-    let mut traj = open(&dump, &ReadOptions::default()).unwrap();
-    let e = render_series(
-        &mut traj,
-        &by_element("50:60".parse().unwrap()),
-        &mut sink,
-        &mut |_| {},
-    )
-    .unwrap_err();
+    let e = fails("50:60", &d.join("g_%05d.png"));
     assert!(matches!(e, SeriesError::NoFrames { count: 11, .. }), "{e}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn fit_all_holds_every_frame_tightly_and_fit_first_only_the_first() {
+    use scene::{Camera, Orbit, View};
+    let d = scratch("fitall");
+    // A small bowl drifting 4 Å along x per frame.
+    let base = molecule::scenes::generate(molecule::scenes::SceneName::Nanobowl, Some(400), 3);
+    let path = d.join("drift.xyz");
+    let mut text = Vec::new();
+    for k in 0..6 {
+        let mut m = base.clone();
+        m.x.iter_mut().for_each(|x| *x += 4.0 * k as f32);
+        molecule::write::write_xyz(&mut text, &m, &format!("frame {k}")).unwrap();
+    }
+    std::fs::write(&path, text).unwrap();
+    let render = |fit_all: bool| {
+        let mut s = by_element("0:6:2".parse().unwrap());
+        let (view, orbit, fov_deg) = (View::Far, Orbit::default(), 45.0);
+        s.camera = if fit_all {
+            CameraChoice::FitAll {
+                view,
+                orbit,
+                fov_deg,
+            }
+        } else {
+            CameraChoice::Fit {
+                view,
+                orbit,
+                fov_deg,
+            }
+        };
+        let mut traj = open(&path, &ReadOptions::default()).unwrap();
+        let out = d.join(format!("f{fit_all}_%d.png"));
+        let mut sink = Sink::open(&OutputKind::from_path(&out).unwrap(), false, 10.0).unwrap();
+        let r = render_series(&mut traj, &s, &mut sink, &mut |_| {}).unwrap();
+        let sphere = r.fitted_to.unwrap();
+        let camera = Camera::fit(view, sphere, fov_deg, 64.0 / 48.0, orbit);
+        assert_eq!(r.camera, Some(camera));
+        (s, sphere)
+    };
+    // Each rendered frame's scene sphere (built in full) and how far it reaches from `c`.
+    let (s, all) = render(true);
+    let reach = |c: [f32; 3], k: usize| {
+        let m = open(&path, &ReadOptions::default())
+            .unwrap()
+            .read_frame(k)
+            .unwrap();
+        let f = Scene::build(s.isa, &m, &s.scene).unwrap().sphere;
+        let d: f32 = (0..3)
+            .map(|i| (f.center[i] - c[i]).powi(2))
+            .sum::<f32>()
+            .sqrt();
+        d + f.radius
+    };
+    let reaches: Vec<f32> = [0, 2, 4].iter().map(|&k| reach(all.center, k)).collect();
+    for (k, r) in reaches.iter().enumerate() {
+        assert!(
+            *r <= all.radius * 1.001,
+            "frame {}: {r} > {}",
+            2 * k,
+            all.radius
+        );
+    }
+    let widest = reaches.iter().copied().fold(0.0, f32::max);
+    assert!(
+        widest >= all.radius * 0.999,
+        "not tight: {widest} < {}",
+        all.radius
+    );
+    // Fitted to the first frame only, the last one sticks out.
+    let (_, first) = render(false);
+    assert!((reach(first.center, 0) - first.radius).abs() <= first.radius * 1e-3);
+    assert!(reach(first.center, 4) > first.radius * 1.05);
     std::fs::remove_dir_all(&d).ok();
 }

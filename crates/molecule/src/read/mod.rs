@@ -10,12 +10,14 @@
 //! the 0-based frame and what was expected; no input makes a reader panic.
 
 mod dump;
+mod follow;
 mod gro;
 mod lammps_data;
 mod lex;
 mod pdb;
 mod xyz;
 
+pub use follow::{FollowError, Follower};
 pub(crate) use lex::LineReader;
 
 use crate::Molecule;
@@ -507,6 +509,16 @@ impl Trajectory {
     /// decodes its (uncompressed) size once.
     pub fn decoded_bytes(&self) -> u64 {
         self.decoded.load(Ordering::Relaxed)
+    }
+
+    /// A new trajectory over the same file with the same options, at its first frame (its
+    /// [`Trajectory::decoded_bytes`] counts from zero).
+    pub fn reopen(&self) -> Result<Trajectory, ReadError> {
+        let opts = ReadOptions {
+            format: Some(self.format),
+            ..self.opts.clone()
+        };
+        open(&self.path, &opts)
     }
 
     /// Whether the file is gzip-compressed.

@@ -1,0 +1,38 @@
+//! Shared by the CLI tests: the binary, run as a user would, sample files and scratch
+//! directories.
+#![allow(dead_code)] // each test binary uses a different part
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// The `bnsview` binary with no ISA forced.
+pub fn bnsview() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_bnsview"));
+    c.env_remove("BNS_ISA").env_remove("BNS_CPU_LIMIT");
+    c
+}
+
+/// Runs `c`: success, stdout, stderr.
+pub fn run(c: &mut Command) -> (bool, String, String) {
+    let out = c.output().expect("run bnsview");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh empty directory for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bnsview-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A sample file of `../shared/data`.
+pub fn sample(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(name)
+}

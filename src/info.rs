@@ -54,6 +54,7 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
         l.load_s,
         &l.bonds,
         l.bond_s,
+        l.unwrap.as_ref(),
         &l.warnings,
     );
     Ok(())
@@ -110,6 +111,7 @@ fn report(
     load_s: f64,
     bonds: &[[u32; 2]],
     bond_s: f64,
+    unwrap: Option<&scene::UnwrapReport>,
     warnings: &[String],
 ) {
     // The breakdown shown is the largest mode at rest (vol+bs, or bs without atoms).
@@ -144,6 +146,10 @@ fn report(
             "bonds_per_atom": if n > 0 { nb as f64 / n as f64 } else { 0.0 },
             "bond_source": format!("{:?}", args.input.bonds).to_lowercase(),
             "pbc": args.input.pbc,
+            "unwrap": unwrap.map(|u| serde_json::json!({
+                "method": format!("{:?}", u.method).to_lowercase(),
+                "crossing_bonds": u.crossing,
+            })),
             "load_seconds": load_s,
             "bond_seconds": bond_s,
             "molecule_bytes": m.memory_bytes(),
@@ -211,6 +217,13 @@ fn report(
         if args.input.pbc { ", pbc" } else { "" },
         bond_s
     );
+    if let Some(u) = unwrap {
+        p!(
+            out,
+            "{}",
+            u.describe().replacen("unwrap:  ", "unwrap:    ", 1)
+        );
+    }
     match file_bytes {
         Some(b) => p!(out, "load:      {load_s:.3} s ({:.1} MB file)", mb(b)),
         None => p!(out, "load:      {load_s:.3} s"),

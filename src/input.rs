@@ -56,6 +56,11 @@ pub struct InputArgs {
     /// Periodic boundaries (minimum image) for bonds, using the file's cell.
     #[arg(long)]
     pub pbc: bool,
+    /// Put molecules split by the periodic boundaries back together before drawing. Needs a
+    /// cell; uses ix iy iz when the file has them, else bonds by minimum image (a bond still
+    /// crossing the cell is then left out, or drawn as half-sticks with --pbc).
+    #[arg(long)]
+    pub unwrap: bool,
 }
 
 /// A spinner on stderr that only appears after half a second and never when stderr is not a
@@ -88,8 +93,10 @@ pub struct Loaded {
     pub bonds: Vec<[u32; 2]>,
     /// Time to read or generate the frame (s).
     pub load_s: f64,
-    /// Time to build the bonds (s).
+    /// Time to build the bonds (s), unwrapping included.
     pub bond_s: f64,
+    /// How the frame was unwrapped (`--unwrap`; `None` without).
+    pub unwrap: Option<scene::UnwrapReport>,
 }
 
 impl InputArgs {
@@ -98,6 +105,7 @@ impl InputArgs {
         Ok(scene::BondSettings {
             source: self.bonds,
             options: self.bond_options()?,
+            unwrap: self.unwrap,
         })
     }
 
@@ -142,7 +150,13 @@ impl InputArgs {
         let mut l = self.load_frame(count_frames)?;
         let pb = spinner(&format!("building bonds for {} atoms", l.molecule.len()));
         let t1 = Instant::now();
-        l.bonds = bonds.build(&l.molecule)?;
+        // The bonds and (with --unwrap) the unwrapped frame, as `render` builds them.
+        let p = bonds.prepare(&l.molecule, self.pbc)?;
+        l.bonds = p.bonds;
+        if let Some(u) = p.unwrapped {
+            l.molecule = u;
+        }
+        l.unwrap = p.unwrap;
         l.bond_s = t1.elapsed().as_secs_f64();
         pb.finish_and_clear();
         Ok(l)
@@ -212,6 +226,7 @@ impl InputArgs {
             bonds: Vec::new(),
             load_s,
             bond_s: 0.0,
+            unwrap: None,
         })
     }
 }

@@ -133,7 +133,10 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
                 eprintln!(
                     "frame {:>5}: {} atoms, read {:.3} s, build {:.3} s, waited {:.3} s, render {:.3} s, write {:.3} s → {}",
                     r.frame, r.atoms, r.read_s, r.build_s, r.wait_s, r.render_s, r.write_s, r.path.display()
-                )
+                );
+                if let Some(u) = &r.unwrap {
+                    eprintln!("             {}", u.describe());
+                }
             });
         }
     };

@@ -389,6 +389,81 @@ fn pbc_draws_half_sticks_and_cell_draws_the_box() {
 }
 
 #[test]
+fn unwrap_draws_the_split_water_as_the_hand_unwrapped_one() {
+    let d = scratch("unwrap");
+    let gro = d.join("water.gro");
+    split_water_gro(&gro);
+    // The same water put together by hand: HW1 at 0.98 - 1 nm.
+    let whole = d.join("whole.gro");
+    let text = std::fs::read_to_string(&gro).unwrap();
+    std::fs::write(&whole, text.replace("   0.980", "  -0.020")).unwrap();
+    let render = |file: &std::path::Path, name: &str, extra: &[&str]| {
+        let out = d.join(name);
+        let (ok, _, err) = run(bnsview()
+            .arg("render")
+            .arg(file)
+            .args(["--size", "120x90", "--view", "front", "-v", "-o"])
+            .arg(&out)
+            .args(extra));
+        assert!(ok, "{err}");
+        (image::open(&out).unwrap().to_rgba8(), err)
+    };
+    // Pixels differing by more than a rounding step.
+    let differ = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        a.pixels()
+            .zip(b.pixels())
+            .filter(|(p, q)| (0..4).any(|k| p.0[k].abs_diff(q.0[k]) > 8))
+            .count()
+    };
+    let (want, _) = render(&whole, "whole.png", &[]);
+    let (unwrapped, err) = render(&gro, "unwrapped.png", &["--unwrap"]);
+    assert!(
+        err.contains("unwrap:  by minimum image along the bonds"),
+        "-v names the method: {err}"
+    );
+    assert!(
+        differ(&unwrapped, &want) < 50,
+        "{}",
+        differ(&unwrapped, &want)
+    );
+    // --pbc --unwrap: nothing crosses any more, so the same picture (no half-sticks).
+    let (both, _) = render(&gro, "both.png", &["--unwrap", "--pbc"]);
+    assert!(differ(&both, &want) < 50);
+    // Without --unwrap the molecule is split over the box: a different picture.
+    let (split, _) = render(&gro, "split.png", &["--pbc"]);
+    assert!(differ(&split, &want) > 500, "{}", differ(&split, &want));
+    // info --unwrap reports the method and the unwrapped bounds (x from -0.2 Å).
+    let (ok, out, err) = run(bnsview().arg("info").arg(&gro).arg("--unwrap"));
+    assert!(ok, "{err}");
+    assert!(out.contains("unwrap:    by minimum image"), "{out}");
+    assert!(out.contains("bounds:    [-0.200,"), "{out}");
+    // An input without a cell says --unwrap needs one.
+    let xyz = d.join("nocell.xyz");
+    std::fs::write(&xyz, "2\nno cell\nC 0 0 0\nC 1.5 0 0\n").unwrap();
+    for cmd in ["render", "info"] {
+        let (ok, _, err) = run(bnsview()
+            .arg(cmd)
+            .arg(&xyz)
+            .arg("--unwrap")
+            .args(if cmd == "render" {
+                vec!["--size", "64x64", "-o"]
+            } else {
+                vec![]
+            })
+            .args(if cmd == "render" {
+                vec![d.join("x.png")]
+            } else {
+                vec![]
+            }));
+        assert!(
+            !ok && err.contains("--unwrap") && err.contains("cell") && !err.contains("panick"),
+            "{cmd}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
 fn colour_range_is_printed_and_obeyed_and_the_legend_sits_at_the_right() {
     let d = scratch("legend");
     let dump = sample("mass_q_elem.lammpstrj");
@@ -637,6 +712,7 @@ fn render_help_is_grouped_under_headings() {
     for (flag, want) in [
         ("--scene", "Input and bonds:"),
         ("--pbc", "Input and bonds:"),
+        ("--unwrap", "Input and bonds:"),
         ("--frames", "Output:"),
         ("--orbit", "Camera:"),
         ("--legend", "Style and colour:"),

@@ -1,5 +1,6 @@
 //! Molecular data for bnsview: the [`Molecule`] frame type, the [`elements`] table, file
-//! readers ([`read`]), writers ([`mod@write`]), the uniform-grid bond builder ([`bonds`]) and the
+//! readers ([`read`]), writers ([`mod@write`]), the uniform-grid bond builder ([`bonds`]),
+//! unwrapping of molecules split by the periodic boundaries ([`mod@unwrap`]) and the
 //! built-in reference scenes ([`scenes`]).
 //!
 //! All lengths are in Ångström (Å), positions are stored as `f32` structure-of-arrays.
@@ -15,6 +16,7 @@ pub mod elements;
 pub mod motion;
 pub mod read;
 pub mod scenes;
+pub mod unwrap;
 pub mod write;
 
 pub use read::{open, Format, FrameIndex, ReadError, ReadOptions, Trajectory};
@@ -163,6 +165,10 @@ pub struct Molecule {
     /// Bonds listed in the file (LAMMPS data `Bonds`, PDB `CONECT`) as 0-based atom indices,
     /// `i < j`, sorted and deduplicated.
     pub file_bonds: Option<Vec<[u32; 2]>>,
+    /// The positions are already unwrapped across the periodic boundaries by the reader
+    /// (LAMMPS dump `xu yu zu` / `xsu ysu zsu` columns, LAMMPS data image flags), so
+    /// [`unwrap`] leaves them as they are.
+    pub unwrapped: bool,
 }
 
 impl Molecule {

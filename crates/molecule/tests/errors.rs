@@ -254,6 +254,9 @@ fn data_ok_and_errors() {
         .replace("2 2 -1.0 1 1 1", "2 2 -1.0 1 1 1 0 0 0");
     let m = &parse(Format::LammpsData, &img).unwrap()[0];
     assert_eq!(m.position(0), [10.0, 0.0, -10.0]);
+    // … so the frame is already unwrapped (`unwrap` leaves it); without flags it is not.
+    assert!(m.unwrapped);
+    assert!(!parse(Format::LammpsData, DATA).unwrap()[0].unwrapped);
     parse_err(
         Format::LammpsData,
         &DATA.replace("2 atoms", "3 atoms"),

@@ -4,8 +4,9 @@
 
 use std::time::Instant;
 
-use molecule::bonds::try_build_bonds;
-use molecule::{elements, Molecule};
+use molecule::bonds::{try_build_bonds, BondOptions};
+use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
+use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
     build_density, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells, MarchOptions,
@@ -83,6 +84,8 @@ pub struct Scene {
     pub estimate: MemoryEstimate,
     /// Per-stage wall times.
     pub timings: Timings,
+    /// How the frame was unwrapped (`None`: [`BondSettings::unwrap`] off).
+    pub unwrap: Option<UnwrapReport>,
     /// Per-atom radius and colour scratch, reused by [`Scene::rebuild`].
     scratch: (Vec<f32>, Vec<u32>),
 }
@@ -112,6 +115,7 @@ impl Scene {
             },
             estimate: MemoryEstimate::default(),
             timings: Timings::default(),
+            unwrap: None,
             scratch: (Vec::new(), Vec::new()),
         };
         s.rebuild_with(isa, m, progress)?;
@@ -139,16 +143,32 @@ impl Scene {
         self.volume = None;
         self.light_volume = None;
         self.timings = Timings::default();
+        self.unwrap = None;
         let st = &self.settings;
         if let Some(ms) = &st.model {
             check_model(ms)?;
-            progress(Stage::Bonds);
-            let t = Instant::now();
-            fill_bonds(&st.bonds, m, &mut self.bonds)?;
-            self.timings.bonds = t.elapsed().as_secs_f64();
-        } else {
-            self.bonds.clear();
         }
+        if st.model.is_some() || st.bonds.unwrap {
+            progress(Stage::Bonds);
+        }
+        let t = Instant::now();
+        let keep_crossing = st.model.as_ref().is_some_and(|ms| ms.periodic_bonds);
+        let unwrapped = prepare_into(
+            &st.bonds,
+            st.model.is_some(),
+            keep_crossing,
+            m,
+            &mut self.bonds,
+        )?;
+        self.timings.bonds = t.elapsed().as_secs_f64();
+        // From here on the frame is the unwrapped one (model, volume, camera sphere).
+        let m = match &unwrapped {
+            Some((u, report)) => {
+                self.unwrap = Some(*report);
+                u
+            }
+            None => m,
+        };
         // Check the budget before the large allocations: the estimated peak of the process
         // (the figure `bnsview info` prints) less what is already resident (the baseline,
         // the frame and the bonds), since the budget is a share of the memory still available.
@@ -254,12 +274,128 @@ fn check_model(ms: &ModelSettings) -> Result<(), SceneError> {
 }
 
 impl BondSettings {
-    /// The bonds of `m` (pairs `i < j`, sorted, for [`BondSource::Auto`]).
+    /// The bonds of `m` (pairs `i < j`, sorted, for [`BondSource::Auto`]); with
+    /// [`BondSettings::unwrap`], the bonds [`BondSettings::prepare`] draws without
+    /// `--pbc`.
     pub fn build(&self, m: &Molecule) -> Result<Vec<[u32; 2]>, SceneError> {
-        let mut out = Vec::new();
-        fill_bonds(self, m, &mut out)?;
-        Ok(out)
+        Ok(self.prepare(m, false)?.bonds)
     }
+
+    /// What [`crate::Scene::build`] makes of frame `m` before the model: the unwrapped frame
+    /// (with [`BondSettings::unwrap`]) and the bonds drawn; `keep_crossing` keeps the bonds
+    /// that still cross the cell after unwrapping ([`ModelSettings::periodic_bonds`]).
+    pub fn prepare(&self, m: &Molecule, keep_crossing: bool) -> Result<Prepared, SceneError> {
+        let mut bonds = Vec::new();
+        let u = prepare_into(self, true, keep_crossing, m, &mut bonds)?;
+        let (unwrapped, unwrap) = match u {
+            Some((m, r)) => (Some(m), Some(r)),
+            None => (None, None),
+        };
+        Ok(Prepared {
+            unwrapped,
+            bonds,
+            unwrap,
+        })
+    }
+}
+
+/// A frame made ready for the model by [`BondSettings::prepare`].
+#[derive(Debug)]
+pub struct Prepared {
+    /// The unwrapped frame (`None`: not unwrapped; use the input as it is).
+    pub unwrapped: Option<Molecule>,
+    /// The bonds drawn (pairs of atom indices `i < j`).
+    pub bonds: Vec<[u32; 2]>,
+    /// How it was unwrapped.
+    pub unwrap: Option<UnwrapReport>,
+}
+
+/// How a frame was unwrapped ([`BondSettings::unwrap`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnwrapReport {
+    /// Image flags, minimum image along bonds, or nothing to do.
+    pub method: UnwrapMethod,
+    /// Bonds that still cross the cell after unwrapping (molecules bonded to their own
+    /// periodic image, such as a bulk network).
+    pub crossing: usize,
+    /// Whether those are drawn (as half-sticks, [`ModelSettings::periodic_bonds`]) or left out.
+    pub crossing_drawn: bool,
+}
+
+impl UnwrapReport {
+    /// One line for `-v`: the method and what became of the bonds still crossing.
+    pub fn describe(&self) -> String {
+        let mut s = format!("unwrap:  by {}", self.method.describe());
+        if self.crossing > 0 {
+            s += &format!(
+                "; {} bonds still cross the cell (bonded to their own image), {}",
+                self.crossing,
+                if self.crossing_drawn {
+                    "drawn as half-sticks"
+                } else {
+                    "not drawn (add --pbc for half-sticks)"
+                }
+            );
+        }
+        s
+    }
+}
+
+/// Fills `out` with the bonds drawn (`draw`: there is a model) and, with `b.unwrap`, returns
+/// the unwrapped copy of `m`: the bonds used to unwrap are detected with the minimum image
+/// (or the file's); those still crossing after unwrapping stay only with `keep_crossing`.
+fn prepare_into(
+    b: &BondSettings,
+    draw: bool,
+    keep_crossing: bool,
+    m: &Molecule,
+    out: &mut Vec<[u32; 2]>,
+) -> Result<Option<(Molecule, UnwrapReport)>, SceneError> {
+    if !b.unwrap {
+        if draw {
+            fill_bonds(b, m, out)?;
+        } else {
+            out.clear();
+        }
+        return Ok(None);
+    }
+    let cell = m.cell.ok_or(UnwrapError::NoCell)?;
+    let method = UnwrapMethod::of(m);
+    out.clear();
+    if (draw && b.source != BondSource::None) || method == UnwrapMethod::Bonds {
+        let pbc = BondSettings {
+            source: if b.source == BondSource::File {
+                BondSource::File
+            } else {
+                BondSource::Auto
+            },
+            options: BondOptions {
+                pbc: true,
+                ..b.options.clone()
+            },
+            unwrap: false,
+        };
+        fill_bonds(&pbc, m, out)?;
+    }
+    let mut u = m.clone();
+    unwrap(&mut u, out)?;
+    let mut report = UnwrapReport {
+        method,
+        crossing: 0,
+        crossing_drawn: keep_crossing,
+    };
+    if !draw || b.source == BondSource::None {
+        out.clear();
+    } else if let Some(mi) = MinimumImage::new(&cell) {
+        let before = out.len();
+        if keep_crossing {
+            report.crossing = out.iter().filter(|b| crosses(&u, &mi, b)).count();
+        } else {
+            out.retain(|b| !crosses(&u, &mi, b));
+            report.crossing = before - out.len();
+        }
+    }
+    Ok(Some((u, report)))
 }
 
 /// Replaces `out` with the bonds of `m`.

@@ -39,6 +39,9 @@ pub enum SceneError {
     /// The bond search refused the atoms (extent or bond count; see [`molecule::bonds::BondError`]).
     #[error(transparent)]
     Bonds(#[from] molecule::bonds::BondError),
+    /// Unwrapping failed (no cell, bad image flags; see [`molecule::unwrap::UnwrapError`]).
+    #[error("--unwrap: {0}")]
+    Unwrap(#[from] molecule::unwrap::UnwrapError),
     /// No atoms.
     #[error("no atoms to build a scene of")]
     NoAtoms,

@@ -37,7 +37,8 @@ const SLOT_BYTES: u64 = 36;
 /// [`MemoryEstimate::measured`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MemoryEstimate {
-    /// The molecule frame (positions, elements, columns, file bonds).
+    /// The molecule frame (positions, elements, columns, file bonds); twice that with
+    /// unwrapping ([`crate::BondSettings::unwrap`]: the unwrapped copy the build uses).
     pub atoms: u64,
     /// Bond list (8 B per bond).
     pub bonds: u64,
@@ -75,8 +76,10 @@ impl MemoryEstimate {
         bonds: usize,
         settings: &SceneSettings,
     ) -> Result<MemoryEstimate, SceneError> {
+        // With unwrapping, the unwrapped copy of the frame is alive during the whole build.
+        let copies = if settings.bonds.unwrap { 2 } else { 1 };
         let mut e = MemoryEstimate {
-            atoms: m.memory_bytes() as u64,
+            atoms: copies * m.memory_bytes() as u64,
             ..MemoryEstimate::default()
         };
         let all_bonds = bonds;

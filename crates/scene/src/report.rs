@@ -3,11 +3,14 @@
 use crate::build::Scene;
 
 impl Scene {
-    /// One line per built stage (`bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
+    /// One line per built stage (`unwrap:`, `bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
     /// and the figures a user checks first (BVH nodes and SAH cost, lattice points, MB).
     pub fn stage_report(&self) -> Vec<String> {
         let mut out = Vec::new();
         let t = &self.timings;
+        if let Some(u) = &self.unwrap {
+            out.push(u.describe());
+        }
         if let Some(model) = &self.model {
             out.push(format!(
                 "bonds:   {:.3} s  {} bonds",

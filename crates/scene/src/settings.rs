@@ -96,6 +96,13 @@ pub struct BondSettings {
     pub source: BondSource,
     /// Rule of [`BondSource::Auto`]: factor (default 1.15), cutoffs (Å), pbc.
     pub options: BondOptions,
+    /// Unwrap the frame across the periodic boundaries before building anything
+    /// ([`molecule::unwrap`], the CLI's `--unwrap`): by the image flags `ix iy iz` when the
+    /// input has them, else by minimum image along the bonds. Needs a cell. The bonds are
+    /// then detected with the minimum image whatever `options.pbc` says (or are the file's),
+    /// and a bond that still crosses the cell after unwrapping (a molecule bonded to its own
+    /// image) is drawn as half-sticks with [`ModelSettings::periodic_bonds`], else not drawn.
+    pub unwrap: bool,
 }
 
 /// The light volume of volumetric shadows (paper §4.5): transmittance towards one light

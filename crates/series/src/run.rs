@@ -82,6 +82,8 @@ pub struct FrameReport {
     pub write_s: f64,
     /// Where it went.
     pub path: std::path::PathBuf,
+    /// How the frame was unwrapped (`None`: `BondSettings::unwrap` off).
+    pub unwrap: Option<scene::UnwrapReport>,
 }
 
 /// What a whole series took.
@@ -324,6 +326,7 @@ fn run_series(
             draw_legend(&mut fb, l, *ink);
         }
         let render_s = t.elapsed().as_secs_f64();
+        let unwrap = b.scene.unwrap;
         drop(b.scene);
         let t = Instant::now();
         let path = sink.write(b.frame, &fb)?;
@@ -336,6 +339,7 @@ fn run_series(
             render_s,
             write_s: t.elapsed().as_secs_f64(),
             path,
+            unwrap,
         };
         report.frames += 1;
         report.build_s += r.read_s + r.build_s;

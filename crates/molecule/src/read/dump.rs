@@ -3,10 +3,13 @@
 //! line up.
 //!
 //! Coordinates are taken from the first available of `x y z`, `xu yu zu`, `xs ys zs`,
-//! `xsu ysu zsu` (the same preference as ASE). Elements come from an `element` column, else
+//! `xsu ysu zsu` (the same preference as ASE); with `xu yu zu` or `xsu ysu zsu` the frame is
+//! marked [`Molecule::unwrapped`], so image flags `ix iy iz` are not applied on top
+//! ([`crate::unwrap`]). Elements come from an `element` column, else
 //! from [`super::ReadOptions::types`], else from a `mass` column (nearest standard weight),
-//! else unknown (Z = 0, with a warning). Other non-coordinate columns (`id`, `type`, `q`,
-//! `mol`, `mass`, ...) are kept as scalars; `timestep` is not stored.
+//! else unknown (Z = 0, with a warning). Every other column (`id`, `type`, `q`, `mol`,
+//! `mass`, `ix iy iz`, and coordinate columns not used for the positions, e.g. `xu` when `x`
+//! is there) is kept as a per-atom scalar of that name; `timestep` is not stored.
 
 use super::lex::{parse_f32, parse_f64, parse_i64, parse_usize, split_spans, trim, SymbolCache};
 use super::{FrameParser, LineReader, ReadError, ReadOptions};
@@ -146,18 +149,18 @@ impl FrameParser for DumpParser {
         let header_line = r.line_no();
         let col = |name: &str| h.columns.iter().position(|c| c == name);
         let mut pos = None;
-        for (names, kind) in [
-            (["x", "y", "z"], Coords::Cart),
-            (["xu", "yu", "zu"], Coords::Cart),
-            (["xs", "ys", "zs"], Coords::Scaled),
-            (["xsu", "ysu", "zsu"], Coords::Scaled),
+        for (names, kind, unwrapped) in [
+            (["x", "y", "z"], Coords::Cart, false),
+            (["xu", "yu", "zu"], Coords::Cart, true),
+            (["xs", "ys", "zs"], Coords::Scaled, false),
+            (["xsu", "ysu", "zsu"], Coords::Scaled, true),
         ] {
             if let (Some(a), Some(b), Some(c)) = (col(names[0]), col(names[1]), col(names[2])) {
-                pos = Some(([a, b, c], kind));
+                pos = Some(([a, b, c], kind, unwrapped));
                 break;
             }
         }
-        let Some((pc, kind)) = pos else {
+        let Some((pc, kind, unwrapped)) = pos else {
             let cols = h.columns.join(" ");
             return Err(r.error(
                 header_line,
@@ -176,14 +179,13 @@ impl FrameParser for DumpParser {
         let type_col = col("type");
         let elem_col = col("element");
         let mass_col = col("mass");
-        let positional = [
-            "x", "y", "z", "xu", "yu", "zu", "xs", "ys", "zs", "xsu", "ysu", "zsu", "element",
-        ];
+        // The coordinate columns used for the positions, and `element`, are not scalars; the
+        // other coordinate columns (`xu` when `x` is there, …) are, so `--color xu` works.
         let scalar_cols: Vec<(String, usize)> = h
             .columns
             .iter()
             .enumerate()
-            .filter(|(_, c)| !positional.contains(&c.as_str()))
+            .filter(|(i, c)| !pc.contains(i) && c.as_str() != "element")
             .map(|(i, c)| (c.clone(), i))
             .collect();
         let n = h.n;
@@ -191,6 +193,7 @@ impl FrameParser for DumpParser {
         let cap = n.min(1 << 26);
         let mut m = Molecule::with_capacity(cap);
         m.cell = h.cell;
+        m.unwrapped = unwrapped;
         let mut scal: Vec<Vec<f32>> = scalar_cols
             .iter()
             .map(|_| Vec::with_capacity(cap))

@@ -2,7 +2,8 @@
 //! `Atoms` (styles `atomic`, `charge`, `molecular`, `full`, with or without image flags) and
 //! `Bonds`. Other sections are skipped. Atoms are sorted by id. Image flags, when present
 //! (three extra integer columns), unwrap the positions: `x + ix·a + iy·b + iz·c` (as LAMMPS
-//! `write_dump ... xu` and ASE do).
+//! `write_dump ... xu` and ASE do); when every atom line has them the frame is marked
+//! [`Molecule::unwrapped`].
 //!
 //! Elements per type: [`super::ReadOptions::types`] first, else the nearest standard atomic
 //! weight to the `Masses` entry (within 0.5 u) read as g/mol, else the same with the entry
@@ -115,6 +116,8 @@ impl FrameParser for DataParser {
         let mut spans = Vec::new();
         let mut has_mol = false;
         let mut has_q = false;
+        // Every atom line had image flags (the positions are unwrapped by them).
+        let mut all_images = true;
         let ec = r.ctx();
         while let Some((ln, line)) = r.next_line()? {
             let (body, comment) = strip_comment(line);
@@ -239,6 +242,7 @@ impl FrameParser for DataParser {
                         }
                     }
                     let mut image = [0i64; 3];
+                    all_images &= spans.len() >= st.ncols() + 3;
                     if spans.len() >= st.ncols() + 3 {
                         for (k, im) in image.iter_mut().enumerate() {
                             match parse_i64(f(st.ncols() + k)) {
@@ -354,6 +358,7 @@ impl FrameParser for DataParser {
             ));
         }
         let mut m = pos;
+        m.unwrapped = all_images && !m.is_empty();
         let mut type_z: HashMap<i32, u8> = HashMap::new();
         for (e, &ty) in m.elements.iter_mut().zip(&types) {
             *e = match type_z.get(&ty) {

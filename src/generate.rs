@@ -72,7 +72,7 @@ pub fn run(args: GenerateArgs) -> anyhow::Result<()> {
             anyhow::Error::new(e).context(format!("cannot create {}", args.output.display()))
         }
     })?;
-    let pb = crate::input::spinner(&format!("generating {}", args.scene));
+    let pb = crate::progress::spinner(&format!("generating {}", args.scene));
     let t = Instant::now();
     let m = try_generate(args.scene, args.atoms, args.seed)?;
     let gen_s = t.elapsed().as_secs_f64();
@@ -110,9 +110,13 @@ pub fn run(args: GenerateArgs) -> anyhow::Result<()> {
     };
     let buf = BufWriter::with_capacity(1 << 20, file);
     if gz {
-        let mut e = flate2::write::GzEncoder::new(buf, flate2::Compression::fast());
+        // Buffered in front of the encoder too: the writers make a call per number, and each
+        // call into the deflater costs far more than a copy into a buffer.
+        let e = flate2::write::GzEncoder::new(buf, flate2::Compression::fast());
+        let mut e = BufWriter::with_capacity(1 << 20, e);
         write(&mut e)
-            .and_then(|_| e.finish())
+            .and_then(|_| e.into_inner().map_err(|e| e.into_error()))
+            .and_then(|e| e.finish())
             .and_then(|mut b| b.flush())
     } else {
         let mut b = buf;

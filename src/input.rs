@@ -2,16 +2,17 @@
 //! scene, one frame of it, and its bonds, with a spinner and timings.
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{bail, Context};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use molecule::bonds::BondOptions;
 use molecule::read::{open, Format, FrameIndex, ReadOptions};
 use molecule::scenes::{try_generate, SceneName};
 use molecule::Molecule;
 use scene::BondSource;
+
+use crate::progress::{bar, follow_bytes, spinner};
 
 /// Where the atoms come from and how they are bonded.
 #[derive(Args, Debug, Clone)]
@@ -61,18 +62,6 @@ pub struct InputArgs {
     /// crossing the cell is then left out, or drawn as half-sticks with --pbc).
     #[arg(long)]
     pub unwrap: bool,
-}
-
-/// A spinner on stderr that only appears after half a second and never when stderr is not a
-/// terminal.
-pub fn spinner(msg: &str) -> ProgressBar {
-    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
-        pb.set_style(style);
-    }
-    pb.set_message(msg.to_string());
-    pb.enable_steady_tick(Duration::from_millis(500));
-    pb
 }
 
 /// A loaded frame with its bonds and what it took.
@@ -192,15 +181,29 @@ impl InputArgs {
                 .context("no input: give a FILE or --scene NAME")?;
             let opts = self.read_options()?;
             let bytes = std::fs::metadata(&path).map(|m| m.len()).ok();
-            pb.set_message(format!("reading {}", path.display()));
             let mut t = open(&path, &opts)?;
-            let m = t.read_frame_at(FrameIndex::from(self.frame))?;
+            // A bar over the file's bytes when they are what is read, else a count of them.
+            pb.finish_and_clear();
+            let what = format!("reading {}", path.display());
+            let pb = match bytes.filter(|_| !t.is_gzip()) {
+                Some(n) => bar(&what, n, true),
+                None => spinner(&what),
+            };
+            let read = t.decoded_counter();
+            let m = follow_bytes(&pb, read.clone(), &what, || {
+                t.read_frame_at(FrameIndex::from(self.frame))
+            })?;
             let frames = if count_frames {
-                pb.set_message("counting frames".to_string());
-                t.count_frames()?
+                pb.set_message(format!("counting the frames of {}", path.display()));
+                let before = read.load(std::sync::atomic::Ordering::Relaxed);
+                if let Some(n) = bytes.filter(|_| !t.is_gzip()) {
+                    pb.set_length(n + before);
+                }
+                follow_bytes(&pb, read, "counting frames", || t.count_frames())?
             } else {
                 0
             };
+            pb.finish_and_clear();
             let w = t.warnings().to_vec();
             (
                 path.display().to_string(),

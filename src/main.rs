@@ -10,6 +10,7 @@ mod info;
 mod input;
 mod isa_cmd;
 mod pipeline;
+mod progress;
 mod render_cmd;
 mod series_cmd;
 

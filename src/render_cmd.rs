@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use render::{
-    draw_legend, render_frame, Camera, FrameInputs, Framebuffer, Legend, Material, Modality,
-    RenderSettings, SecondaryTraversal, DARK_BACKGROUND, HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
+    draw_legend, render_frame_with_progress, Camera, FrameInputs, Framebuffer, Legend, Material,
+    Modality, RenderSettings, SecondaryTraversal, DARK_BACKGROUND, HEADLIGHT_AMBIENT,
+    WHITE_BACKGROUND,
 };
 use scene::{
     ColorBy, LightVolumeSettings, Orbit, Scene, SceneSettings, ViewPreset, LIGHT_VOLUME_STRIDE,
@@ -352,7 +353,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         m.len()
     ));
     let settings = scene_settings(&args, &input, tf)?;
-    let pb = crate::input::spinner("building the scene");
+    let pb = crate::progress::spinner("building the scene");
     let sc = Scene::build_with(isa, m, &settings, &|st| {
         pb.set_message(format!("building the scene: {st:?}"))
     })?;
@@ -381,8 +382,14 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         camera: &camera,
     };
     let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
-    let pb = crate::input::spinner(&format!("rendering {w}x{h} {}", args.mode.name()));
-    let stats = render_frame(&inputs, &settings, &mut fb, isa)?;
+    let pb = crate::progress::bar(
+        &format!("rendering {w}x{h} {}", args.mode.name()),
+        h as u64,
+        false,
+    );
+    let stats = render_frame_with_progress(&inputs, &settings, &mut fb, isa, &mut |done, _| {
+        pb.set_position(done as u64)
+    })?;
     pb.finish_and_clear();
     if let (Some(md), ColorBy::Column { name, colormap, .. }) = (
         scene,

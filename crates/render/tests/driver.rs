@@ -4,8 +4,8 @@
 
 use molecule::scenes::{generate, SceneName};
 use render::{
-    accumulate, render_frame, render_rows, render_tiles, Accum, Camera, FrameInputs, Framebuffer,
-    Material, Modality, RenderSettings, TileSet, View, DARK_BACKGROUND,
+    accumulate, render_frame, render_frame_with_progress, render_rows, render_tiles, Accum, Camera,
+    FrameInputs, Framebuffer, Material, Modality, RenderSettings, TileSet, View, DARK_BACKGROUND,
 };
 use scene::{Scene, SceneSettings, VolumeSettings};
 use spmd::Isa;
@@ -159,6 +159,14 @@ fn row_bands_together_are_the_whole_frame() {
                 rows == whole.pixels,
                 "{isa} {name}: bands differ from one frame"
             );
+            // The progress bar's bands: the same frame, rows reported in order up to H.
+            let mut banded = Framebuffer::new(W, H, 0).unwrap();
+            let mut done = Vec::new();
+            render_frame_with_progress(&inp, &set, &mut banded, isa, &mut |d, h| done.push((d, h)))
+                .unwrap();
+            assert!(banded == whole, "{isa} {name}: progress bands differ");
+            assert!(done.len() > 1 && done.last() == Some(&(H, H)), "{done:?}");
+            assert!(done.windows(2).all(|p| p[0].0 < p[1].0), "{done:?}");
         }
     }
 }

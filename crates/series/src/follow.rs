@@ -34,7 +34,10 @@ struct Followed<'a> {
 }
 
 impl Frames for Followed<'_> {
-    fn next_frame(&mut self) -> Result<Option<(usize, Molecule)>, SeriesError> {
+    fn next_frame(
+        &mut self,
+        cancel: &AtomicBool,
+    ) -> Result<Option<(usize, Molecule)>, SeriesError> {
         loop {
             if self.f.max_frames.is_some_and(|n| self.given >= n)
                 || self.range.end.is_some_and(|e| self.follower.frames() >= e)
@@ -42,7 +45,7 @@ impl Frames for Followed<'_> {
                 return Ok(None);
             }
             let m = loop {
-                if self.f.stop.load(Ordering::Relaxed) {
+                if self.f.stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed) {
                     return Ok(None);
                 }
                 match self.follower.try_next()? {

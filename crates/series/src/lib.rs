@@ -1,6 +1,6 @@
 //! Time series (paper §4, issue #15): the frames of a trajectory rendered in order, in one
-//! pass through the file, with the next frame read and its scene (bonds, BVH, volume) built
-//! on a background thread while the current one renders. The camera and the colour and
+//! pass through the file, with the frame after next read on one background thread and the
+//! next one's scene (bonds, BVH, volume) built on another while the current one renders. The camera and the colour and
 //! density ranges are fixed by the first frame, so a movie does not jump or flicker. Frames go
 //! to numbered PNG/JPEG files, an animated GIF or a video ([`Sink`]). A file a simulation is
 //! still writing can be followed, each frame rendered when it is complete ([`follow_series`]).

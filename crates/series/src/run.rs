@@ -1,7 +1,8 @@
-//! The series loop: frames read and their scenes built on a background thread one frame
-//! ahead of the renderer (paper §4: the next time step is prepared while the current one is
-//! shown), at most two scenes alive.
+//! The series loop: frames read on one background thread two frames ahead of the renderer and
+//! their scenes built on another one frame ahead (paper §4: the next time step is prepared
+//! while the current one is shown), at most two scenes alive.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::sync_channel;
 use std::time::Instant;
 
@@ -56,8 +57,9 @@ pub struct SeriesSettings {
     pub camera: CameraChoice,
     /// Draw a colour legend (when colouring by a column) with text of this colour.
     pub legend_ink: Option<[u8; 3]>,
-    /// Build the next frame on a background thread while this one renders (off: one after
-    /// the other, for comparison).
+    /// Read the frame after next on one background thread and build the next on another
+    /// while this one renders (off: read, build and render one after the other, for
+    /// comparison).
     pub pipelined: bool,
     /// SIMD backend of the builds and the renderer.
     pub isa: Isa,
@@ -120,8 +122,10 @@ struct Built {
 /// Where the frames of a series come from: a file read once from its start, or a growing
 /// file followed as it is written.
 pub(crate) trait Frames: Send {
-    /// The next frame to render and its index in the file; `None` when the series is over.
-    fn next_frame(&mut self) -> Result<Option<(usize, Molecule)>, SeriesError>;
+    /// The next frame to render and its index in the file; `None` when the series is over,
+    /// or when `cancel` is set while waiting for a frame.
+    fn next_frame(&mut self, cancel: &AtomicBool)
+        -> Result<Option<(usize, Molecule)>, SeriesError>;
     /// The error when the series ends before its first frame.
     fn none_error(&self) -> SeriesError;
     /// Whether a GIF or video holding the frames so far is completed, not removed, when the
@@ -140,7 +144,7 @@ struct Ranged<'a> {
 }
 
 impl Frames for Ranged<'_> {
-    fn next_frame(&mut self) -> Result<Option<(usize, Molecule)>, SeriesError> {
+    fn next_frame(&mut self, _: &AtomicBool) -> Result<Option<(usize, Molecule)>, SeriesError> {
         loop {
             if self.range.end.is_some_and(|e| self.next >= e) {
                 return Ok(None);
@@ -172,20 +176,39 @@ fn read_and_build(
     isa: Isa,
 ) -> Result<Option<Built>, SeriesError> {
     let t = Instant::now();
-    let Some((frame, m)) = frames.next_frame()? else {
+    let Some((frame, m)) = frames.next_frame(&AtomicBool::new(false))? else {
         return Ok(None);
     };
-    let read_s = t.elapsed().as_secs_f64();
+    build(frame, m, t.elapsed().as_secs_f64(), settings, isa).map(Some)
+}
+
+/// Builds the scene of frame `frame`, read in `read_s` seconds.
+fn build(
+    frame: usize,
+    m: Molecule,
+    read_s: f64,
+    settings: &SceneSettings,
+    isa: Isa,
+) -> Result<Built, SeriesError> {
     let t = Instant::now();
     let scene =
         Scene::build(isa, &m, settings).map_err(|error| SeriesError::Scene { frame, error })?;
-    Ok(Some(Built {
+    Ok(Built {
         frame,
         atoms: m.len(),
         scene,
         read_s,
         build_s: t.elapsed().as_secs_f64(),
-    }))
+    })
+}
+
+/// Sets its flag when dropped (however the scope it lives in is left).
+struct SetOnDrop<'a>(&'a AtomicBool);
+
+impl Drop for SetOnDrop<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
 }
 
 /// Renders the frames `s.frames` of `traj` (read from its current position onwards, once)
@@ -355,23 +378,39 @@ fn run_series(
             render_one(b, wait)?;
         }
     } else {
-        // A rendezvous channel: the builder blocks with frame k+1 built until the renderer
-        // takes it, so at most two scenes are alive (k rendering, k+1 waiting).
+        // Three stages on rendezvous channels: a reader parses frame k+2 (serial work, one
+        // core) while a builder builds frame k+1 (parallel) and this thread renders frame k.
+        // The builder blocks with k+1 built until the renderer takes it, so at most two scenes
+        // are alive (k rendering, k+1 waiting) and one parsed frame waits for the builder.
+        let (mtx, mrx) = sync_channel::<Result<(usize, Molecule, f64), SeriesError>>(0);
         let (tx, rx) = sync_channel::<Result<Built, SeriesError>>(0);
         let settings = &settings;
+        let cancel = AtomicBool::new(false);
+        let cancel = &cancel;
         std::thread::scope(|scope| -> Result<(), SeriesError> {
-            // Owned here, so an error return drops it and a builder blocked on `send` exits.
+            // Owned here, so an error return drops it: the builder's `send` fails, it exits
+            // and drops `mrx`, and the reader's `send` fails. `_stop` tells a reader that is
+            // waiting for a followed file to grow to give up.
             let rx = rx;
+            let _stop = SetOnDrop(cancel);
             scope.spawn(move || loop {
-                match read_and_build(frames, settings, s.isa) {
-                    Ok(Some(b)) => {
-                        if tx.send(Ok(b)).is_err() {
-                            return;
-                        }
-                    }
+                let t = Instant::now();
+                let item = match frames.next_frame(cancel) {
+                    Ok(Some((k, m))) => Ok((k, m, t.elapsed().as_secs_f64())),
                     Ok(None) => return,
-                    Err(e) => {
-                        tx.send(Err(e)).ok();
+                    Err(e) => Err(e),
+                };
+                let last = item.is_err();
+                if mtx.send(item).is_err() || last {
+                    return;
+                }
+            });
+            scope.spawn(move || {
+                for item in mrx {
+                    let built = item
+                        .and_then(|(frame, m, read_s)| build(frame, m, read_s, settings, s.isa));
+                    let last = built.is_err();
+                    if tx.send(built).is_err() || last {
                         return;
                     }
                 }

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use common::{png, scratch, settings, water_frames};
+use common::{gif_frames, png, scratch, settings, water_frames};
 use molecule::read::{open, Follower, ReadOptions};
 use series::{follow_series, render_series, FollowSettings, FrameRange, OutputKind, Sink};
 
@@ -110,11 +110,31 @@ fn a_stop_request_completes_the_gif_with_the_frames_so_far() {
     .unwrap();
     drop(sink);
     assert_eq!(report.frames, 2);
-    let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
-        std::fs::File::open(&gif).unwrap(),
-    ))
-    .map(|dec| image::AnimationDecoder::into_frames(dec).count())
-    .unwrap();
-    assert_eq!(frames, 2);
+    assert_eq!(gif_frames(&gif), 2);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn an_error_while_following_ends_the_series_instead_of_waiting_on() {
+    // The output directory vanishes after the first frame: writing the second fails while
+    // the reader waits for a third frame that never comes; the error must end the wait.
+    let d = scratch("follow-error");
+    let growing = d.join("growing.lammpstrj");
+    std::fs::write(&growing, water_frames(2).concat()).unwrap();
+    let out = d.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let mut follower = Follower::new(&growing, &ReadOptions::default()).unwrap();
+    let kind = OutputKind::from_path(&out.join("f_%d.png")).unwrap();
+    let mut sink = Sink::open(&kind, false, 10.0).unwrap();
+    let f = follow(None, Arc::new(AtomicBool::new(false)));
+    let e = follow_series(
+        &mut follower,
+        &settings(FrameRange::ALL, true),
+        &f,
+        &mut sink,
+        &mut |_| std::fs::remove_dir_all(&out).unwrap(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("f_1"), "{e}");
     std::fs::remove_dir_all(&d).ok();
 }

@@ -511,6 +511,12 @@ impl Trajectory {
         self.decoded.load(Ordering::Relaxed)
     }
 
+    /// The live count behind [`Trajectory::decoded_bytes`], for a progress display on another
+    /// thread while this one reads.
+    pub fn decoded_counter(&self) -> Arc<AtomicU64> {
+        self.decoded.clone()
+    }
+
     /// A new trajectory over the same file with the same options, at its first frame (its
     /// [`Trajectory::decoded_bytes`] counts from zero).
     pub fn reopen(&self) -> Result<Trajectory, ReadError> {

@@ -112,3 +112,12 @@ pub fn by_element(frames: FrameRange) -> SeriesSettings {
 pub fn png(p: &Path) -> Vec<u8> {
     image::open(p).unwrap().to_rgba8().into_raw()
 }
+
+/// Frames in the animated GIF at `p`, decoded.
+pub fn gif_frames(p: &Path) -> usize {
+    let dec = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(p).unwrap(),
+    ))
+    .unwrap();
+    image::AnimationDecoder::into_frames(dec).count()
+}

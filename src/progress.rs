@@ -1,0 +1,66 @@
+//! Progress on stderr for the steps that can take a while: spinners for steps of unknown
+//! length, bars for reading a file and rendering a frame. Nothing is drawn when stderr is not a
+//! terminal, and nothing before half a second has passed.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{channel, RecvTimeoutError};
+use std::sync::Arc;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// A spinner with `msg` and the time elapsed.
+pub fn spinner(msg: &str) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+        pb.set_style(style);
+    }
+    pb.set_message(msg.to_string());
+    pb.enable_steady_tick(Duration::from_millis(500));
+    pb
+}
+
+/// A bar of `len` steps with `msg`, the percentage and the time left; `bytes` counts in bytes.
+pub fn bar(msg: &str, len: u64, bytes: bool) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    let template = if bytes {
+        "{msg} [{bar:30}] {bytes}/{total_bytes} ({elapsed}, {eta} left)"
+    } else {
+        "{msg} [{bar:30}] {percent}% ({elapsed}, {eta} left)"
+    };
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        pb.set_style(style.progress_chars("=> "));
+    }
+    pb.set_message(msg.to_string());
+    pb.enable_steady_tick(Duration::from_millis(500));
+    pb
+}
+
+/// Runs `work` while `pb` follows the byte count `read` (every 0.2 s): as its position when
+/// the bar has a length, else in its message after `what`.
+pub fn follow_bytes<T>(
+    pb: &ProgressBar,
+    read: Arc<AtomicU64>,
+    what: &str,
+    work: impl FnOnce() -> T,
+) -> T {
+    let (done, wait) = channel::<()>();
+    let read = &read;
+    std::thread::scope(|s| {
+        s.spawn(move || loop {
+            let b = read.load(Ordering::Relaxed);
+            if pb.length().is_some() {
+                pb.set_position(b);
+            } else {
+                pb.set_message(format!("{what} ({} MB decoded)", b / 1_000_000));
+            }
+            match wait.recv_timeout(Duration::from_millis(200)) {
+                Err(RecvTimeoutError::Timeout) => {}
+                _ => return,
+            }
+        });
+        let out = work();
+        drop(done);
+        out
+    })
+}

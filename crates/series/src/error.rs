@@ -53,21 +53,30 @@ pub enum SeriesError {
         /// Frames in the file.
         count: usize,
     },
-    /// File system error.
-    #[error("{path}: {source}")]
+    /// File system error. The message includes the underlying error's text, so it is not
+    /// also a `source()` (an error chain printer would repeat it).
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: String,
         /// Why.
-        source: std::io::Error,
+        error: std::io::Error,
     },
-    /// Image encoder error.
-    #[error("writing {path}: {source}")]
+    /// Image encoder error (its text in the message, not a `source()`, as for `Io`).
+    #[error("writing {path}: {error}")]
     Image {
         /// The file.
         path: String,
         /// Why.
-        source: image::ImageError,
+        error: image::ImageError,
+    },
+    /// The directory of a numbered output does not exist.
+    #[error("cannot write {pattern}: directory {dir} does not exist (create it first)")]
+    NoDirectory {
+        /// The output pattern.
+        pattern: String,
+        /// Its directory.
+        dir: String,
     },
 }
 
@@ -75,13 +84,13 @@ impl SeriesError {
     pub(crate) fn io(path: &Path, source: std::io::Error) -> SeriesError {
         SeriesError::Io {
             path: path.display().to_string(),
-            source,
+            error: source,
         }
     }
     pub(crate) fn image(path: &Path, source: image::ImageError) -> SeriesError {
         SeriesError::Image {
             path: path.display().to_string(),
-            source,
+            error: source,
         }
     }
 }

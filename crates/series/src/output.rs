@@ -103,11 +103,20 @@ impl Sink {
     /// files are checked one by one as they are written).
     pub fn open(kind: &OutputKind, force: bool, gif_fps: f32) -> Result<Sink, SeriesError> {
         match kind {
-            OutputKind::Numbered(p) => Ok(Sink::Files {
-                pattern: p.clone(),
-                force,
-                written: Vec::new(),
-            }),
+            OutputKind::Numbered(p) => {
+                let dir = Path::new(p).parent().filter(|d| !d.as_os_str().is_empty());
+                if let Some(dir) = dir.filter(|d| !d.is_dir()) {
+                    return Err(SeriesError::NoDirectory {
+                        pattern: p.clone(),
+                        dir: dir.display().to_string(),
+                    });
+                }
+                Ok(Sink::Files {
+                    pattern: p.clone(),
+                    force,
+                    written: Vec::new(),
+                })
+            }
             OutputKind::Gif(path) => {
                 refuse_existing(path, force)?;
                 let file = File::create(path).map_err(|e| SeriesError::io(path, e))?;

@@ -1,13 +1,14 @@
 //! `bnsview render`: a molecule file or a built-in scene to a PNG.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use render::{
-    draw_legend, render_frame_with_progress, Camera, FrameInputs, Framebuffer, Legend, Material,
-    Modality, RenderSettings, SecondaryTraversal, DARK_BACKGROUND, HEADLIGHT_AMBIENT,
-    WHITE_BACKGROUND,
+    draw_legend, render_frame, render_frame_with_progress, Camera, FrameInputs, Framebuffer,
+    Legend, Material, Modality, RenderSettings, SecondaryTraversal, DARK_BACKGROUND,
+    HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
 };
 use scene::{
     ColorBy, LightVolumeSettings, Orbit, Scene, SceneSettings, ViewPreset, LIGHT_VOLUME_STRIDE,
@@ -387,9 +388,15 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         h as u64,
         false,
     );
-    let stats = render_frame_with_progress(&inputs, &settings, &mut fb, isa, &mut |done, _| {
-        pb.set_position(done as u64)
-    })?;
+    // Bands cost up to ~10-20 % on a 50-150 ms frame (threads idle at each band's end:
+    // BENCHMARKS.md, "Progress bands"), so only when a bar can be seen.
+    let stats = if std::io::stderr().is_terminal() {
+        render_frame_with_progress(&inputs, &settings, &mut fb, isa, &mut |done, _| {
+            pb.set_position(done as u64)
+        })?
+    } else {
+        render_frame(&inputs, &settings, &mut fb, isa)?
+    };
     pb.finish_and_clear();
     if let (Some(md), ColorBy::Column { name, colormap, .. }) = (
         scene,

@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-use common::{bnsview, run, sample, scratch};
+use common::{bnsview, refused, run, sample, scratch};
 
 /// A 4-frame generated dump, written whole to `dir/whole.lammpstrj`; the text of each frame.
 fn frames(dir: &Path) -> Vec<String> {
@@ -123,33 +123,29 @@ fn ctrl_c_finishes_the_frame_and_exits_cleanly() {
 fn follow_refuses_what_it_cannot_follow() {
     let d = scratch("follow-refuse");
     let gz = sample("spce_water.lammpstrj.gz");
+    // `render ARGS` in the scratch directory.
+    let render = |args: &[&dyn AsRef<std::ffi::OsStr>]| {
+        let mut c = bnsview();
+        c.current_dir(&d).arg("render").args(args);
+        c
+    };
     for (args, want) in [
-        (vec!["--follow"], "uncompressed"),
-        (vec!["--follow", "--poll", "0"], "--poll"),
-        (vec!["--max-frames", "2"], "--follow"),
-        (vec!["--follow", "--frame", "1"], "--frame"),
+        (&["--follow"][..], "uncompressed"),
+        (&["--follow", "--poll", "0"], "--poll"),
+        (&["--max-frames", "2"], "--follow"),
+        (&["--follow", "--frame", "1"], "--frame"),
     ] {
-        let (ok, _, err) = run(bnsview().current_dir(&d).arg("render").arg(&gz).args(&args));
-        assert!(!ok && err.contains(want), "{args:?}: {err}");
+        refused(render(&[&gz]).args(args), &[want]);
     }
-    let (ok, _, err) = run(bnsview()
-        .current_dir(&d)
-        .args(["render", "--scene", "nanobowl", "--follow"]));
-    assert!(!ok && err.contains("trajectory file"), "{err}");
+    refused(
+        &mut render(&[&"--scene", &"nanobowl", &"--follow"]),
+        &["trajectory file"],
+    );
     // Every frame cannot be known before the first is rendered.
     let xyz = d.join("a.xyz");
     std::fs::write(&xyz, "1\nc\nC 0 0 0\n").unwrap();
-    let (ok, _, err) = run(bnsview()
-        .current_dir(&d)
-        .arg("render")
-        .arg(&xyz)
-        .args(["--follow", "--frames", "all", "--fit", "all"]));
-    assert!(!ok && err.contains("--fit all"), "{err}");
-    let (ok, _, err) = run(bnsview()
-        .current_dir(&d)
-        .arg("render")
-        .arg(&xyz)
-        .args(["--fit", "all"]));
-    assert!(!ok && err.contains("--frames"), "{err}");
+    let follow_all = ["--follow", "--frames", "all", "--fit", "all"];
+    refused(render(&[&xyz]).args(follow_all), &["--fit all"]);
+    refused(render(&[&xyz]).args(["--fit", "all"]), &["--frames"]);
     std::fs::remove_dir_all(&d).ok();
 }

@@ -36,3 +36,15 @@ pub fn sample(name: &str) -> PathBuf {
         .join("../shared/data")
         .join(name)
 }
+
+/// Runs `c` and checks it fails with every text of `wants` in its stderr and no panic;
+/// returns the stderr.
+pub fn refused(c: &mut Command, wants: &[&str]) -> String {
+    let (ok, _, err) = run(c);
+    assert!(!ok, "{c:?} succeeded: {err}");
+    assert!(!err.contains("panicked"), "{c:?} panicked: {err}");
+    for w in wants {
+        assert!(err.contains(w), "{c:?}: no {w:?} in {err}");
+    }
+    err
+}

@@ -31,56 +31,66 @@ fn dump(frames: usize, atoms: usize) -> String {
     dump_frames(frames, atoms).concat()
 }
 
+/// The text of each of `frames` frames: `head(k)`, a line `atom(k, i, position)` per atom,
+/// then `tail`.
+fn frames_text(
+    frames: usize,
+    atoms: usize,
+    head: impl Fn(usize) -> String,
+    atom: impl Fn(usize, usize, [f64; 3]) -> String,
+    tail: &str,
+) -> Vec<String> {
+    (0..frames)
+        .map(|k| {
+            let lines: String = (0..atoms).map(|i| atom(k, i, pos(k, i)) + "\n").collect();
+            head(k) + &lines + tail
+        })
+        .collect()
+}
+
 /// The text of each frame of a dump.
 fn dump_frames(frames: usize, atoms: usize) -> Vec<String> {
-    let mut out = Vec::new();
-    for k in 0..frames {
-        let mut s = format!(
+    let head = |k: usize| {
+        format!(
             "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n{atoms}\n",
             k * 100
-        );
-        s += "ITEM: BOX BOUNDS pp pp pp\n0 20\n0 20\n0 20\nITEM: ATOMS id type x y z\n";
-        for i in 0..atoms {
-            let [x, y, z] = pos(k, i);
-            s += &format!("{} {} {x} {y} {z}\n", i + 1, 1 + i % 2);
-        }
-        out.push(s);
-    }
-    out
+        ) + "ITEM: BOX BOUNDS pp pp pp\n0 20\n0 20\n0 20\nITEM: ATOMS id type x y z\n"
+    };
+    let atom = |_, i: usize, [x, y, z]: [f64; 3]| format!("{} {} {x} {y} {z}", i + 1, 1 + i % 2);
+    frames_text(frames, atoms, head, atom, "")
 }
 
 fn xyz_frames(frames: usize, atoms: usize) -> Vec<String> {
-    let mut out = Vec::new();
-    for k in 0..frames {
-        let mut s = format!("{atoms}\nframe {k}\n");
-        for i in 0..atoms {
-            let [x, y, z] = pos(k, i);
-            s += &format!("{} {x} {y} {z}\n", if i % 2 == 0 { "O" } else { "H" });
-        }
-        out.push(s);
-    }
-    out
+    let head = |k| format!("{atoms}\nframe {k}\n");
+    let atom = |_, i: usize, [x, y, z]: [f64; 3]| {
+        format!(
+            "{} {x} {y} {z}",
+            if i.is_multiple_of(2) { "O" } else { "H" }
+        )
+    };
+    frames_text(frames, atoms, head, atom, "")
 }
 
 fn gro_frames(frames: usize, atoms: usize) -> Vec<String> {
-    let mut out = Vec::new();
-    for k in 0..frames {
-        let mut s = format!("water t= {k}.0\n{atoms:5}\n");
-        for i in 0..atoms {
-            let [x, y, z] = pos(k, i).map(|v| v / 10.0);
-            let name = if i % 2 == 0 { "OW" } else { "HW1" };
-            s += &format!(
-                "{:5}{:<5}{:>5}{:5}{x:8.3}{y:8.3}{z:8.3}\n",
-                1 + i / 3,
-                "SOL",
-                name,
-                i + 1
-            );
-        }
-        s += "   2.00000   2.00000   2.00000\n";
-        out.push(s);
-    }
-    out
+    let head = |k| format!("water t= {k}.0\n{atoms:5}\n");
+    let atom = |_, i: usize, p: [f64; 3]| {
+        let [x, y, z] = p.map(|v| v / 10.0);
+        let name = if i.is_multiple_of(2) { "OW" } else { "HW1" };
+        format!(
+            "{:5}{:<5}{:>5}{:5}{x:8.3}{y:8.3}{z:8.3}",
+            1 + i / 3,
+            "SOL",
+            name,
+            i + 1
+        )
+    };
+    frames_text(
+        frames,
+        atoms,
+        head,
+        atom,
+        "   2.00000   2.00000   2.00000\n",
+    )
 }
 
 fn append(path: &Path, bytes: &[u8]) {

@@ -5,6 +5,7 @@
 mod common;
 
 use std::io::Write;
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -83,32 +84,36 @@ fn a_followed_dump_gives_exactly_the_frames_written_until_max_frames() {
     }
 }
 
-#[test]
-fn a_stop_request_completes_the_gif_with_the_frames_so_far() {
-    let d = scratch("follow-stop");
+/// Follows a file holding two water frames (and never more) in `d`, to `out`, pipelined,
+/// until `stop` is set or an error; `on_frame` runs after each frame is written.
+fn follow_two_frames(
+    d: &Path,
+    out: &Path,
+    stop: Arc<AtomicBool>,
+    on_frame: &mut dyn FnMut(&series::FrameReport),
+) -> Result<series::SeriesReport, series::SeriesError> {
     let growing = d.join("growing.lammpstrj");
     std::fs::write(&growing, water_frames(2).concat()).unwrap();
     let mut follower = Follower::new(&growing, &ReadOptions::default()).unwrap();
+    let mut sink = Sink::open(&OutputKind::from_path(out).unwrap(), false, 10.0).unwrap();
+    let s = settings(FrameRange::ALL, true);
+    follow_series(&mut follower, &s, &follow(None, stop), &mut sink, on_frame)
+}
+
+#[test]
+fn a_stop_request_completes_the_gif_with_the_frames_so_far() {
+    let d = scratch("follow-stop");
     let gif = d.join("live.gif");
-    let mut sink = Sink::open(&OutputKind::from_path(&gif).unwrap(), false, 10.0).unwrap();
     let stop = Arc::new(AtomicBool::new(false));
-    let f = follow(None, stop.clone());
     // Stop once two frames are written; the file holds no third, so only the stop ends it.
     let mut n = 0;
-    let report = follow_series(
-        &mut follower,
-        &settings(FrameRange::ALL, true),
-        &f,
-        &mut sink,
-        &mut |_| {
-            n += 1;
-            if n == 2 {
-                stop.store(true, Ordering::Relaxed);
-            }
-        },
-    )
+    let report = follow_two_frames(&d, &gif, stop.clone(), &mut |_| {
+        n += 1;
+        if n == 2 {
+            stop.store(true, Ordering::Relaxed);
+        }
+    })
     .unwrap();
-    drop(sink);
     assert_eq!(report.frames, 2);
     assert_eq!(gif_frames(&gif), 2);
     std::fs::remove_dir_all(&d).ok();
@@ -119,21 +124,12 @@ fn an_error_while_following_ends_the_series_instead_of_waiting_on() {
     // The output directory vanishes after the first frame: writing the second fails while
     // the reader waits for a third frame that never comes; the error must end the wait.
     let d = scratch("follow-error");
-    let growing = d.join("growing.lammpstrj");
-    std::fs::write(&growing, water_frames(2).concat()).unwrap();
     let out = d.join("out");
     std::fs::create_dir(&out).unwrap();
-    let mut follower = Follower::new(&growing, &ReadOptions::default()).unwrap();
-    let kind = OutputKind::from_path(&out.join("f_%d.png")).unwrap();
-    let mut sink = Sink::open(&kind, false, 10.0).unwrap();
-    let f = follow(None, Arc::new(AtomicBool::new(false)));
-    let e = follow_series(
-        &mut follower,
-        &settings(FrameRange::ALL, true),
-        &f,
-        &mut sink,
-        &mut |_| std::fs::remove_dir_all(&out).unwrap(),
-    )
+    let stop = Arc::new(AtomicBool::new(false));
+    let e = follow_two_frames(&d, &out.join("f_%d.png"), stop, &mut |_| {
+        std::fs::remove_dir_all(&out).unwrap()
+    })
     .unwrap_err();
     assert!(e.to_string().contains("f_1"), "{e}");
     std::fs::remove_dir_all(&d).ok();

@@ -11,8 +11,8 @@ use spmd::Isa;
 
 use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel};
 
+use crate::look::parse_size;
 use crate::pipeline::GeometryArgs;
-use crate::render_cmd::parse_size;
 
 /// Which of the paper's views (Table 3).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -153,7 +153,7 @@ pub fn run(a: BenchArgs, isas: Vec<Isa>) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render_cmd::Mode;
+    use crate::look::Mode;
     use bnsbench::{plan, BenchMode};
 
     fn args(extra: &[&str]) -> BenchArgs {
@@ -229,17 +229,13 @@ mod tests {
         #[derive(Parser)]
         struct R {
             #[command(flatten)]
-            r: crate::render_cmd::RenderArgs,
+            r: crate::look::LookArgs,
         }
         for m in BenchMode::ALL {
             let argv = std::iter::once("render").chain(render_flags(m).iter().copied());
             let a = R::parse_from(argv).r;
-            crate::render_cmd::check_modalities(&a).unwrap();
-            assert_eq!(
-                crate::render_cmd::render_settings(&a),
-                m.settings(),
-                "{m:?}"
-            );
+            crate::look::check_modalities(&a).unwrap();
+            assert_eq!(crate::look::render_settings(&a), m.settings(), "{m:?}");
             assert_eq!(a.mode != Mode::Volume, m.geometry(), "{m:?}");
             assert_eq!(
                 matches!(a.mode, Mode::Volume | Mode::VolBs),

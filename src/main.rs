@@ -9,6 +9,7 @@ mod generate;
 mod info;
 mod input;
 mod isa_cmd;
+mod look;
 mod pipeline;
 mod progress;
 mod render_cmd;

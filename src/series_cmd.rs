@@ -16,10 +16,10 @@ use series::{
     SeriesSettings, Sink,
 };
 use spmd::Isa;
-use volume::TransferFunction;
 
 use crate::input::InputArgs;
-use crate::render_cmd::{background, render_settings, scene_settings, FitFrames, Mode, RenderArgs};
+use crate::look::{background, render_settings, scene_settings};
+use crate::render_cmd::{FitFrames, RenderArgs};
 
 /// Renders `args.frames` of the input file.
 pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
@@ -39,23 +39,15 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         PathBuf::from(format!("{stem}_%05d.png"))
     });
     let kind = OutputKind::from_path(&output)?;
-    let tf = if matches!(args.mode, Mode::Bs | Mode::Path) {
-        None
-    } else {
-        Some(TransferFunction::from_spec(&args.tf)?)
-    };
-    let scene = scene_settings(args, input, tf)?;
-    let render = render_settings(args);
-    let (w, h) = args.size;
-    let camera = match &args.camera {
+    let tf = args.look.transfer_function()?;
+    let scene = scene_settings(&args.look, input, tf)?;
+    let render = render_settings(&args.look);
+    let (w, h) = args.look.size;
+    let camera = match &args.look.camera {
         Some(spec) => CameraChoice::Fixed(spec.parse::<Camera>()?),
         None => {
-            let (view, mut orbit) = args.view.view_and_orbit();
-            if let Some(o) = args.orbit {
-                (orbit.azimuth_deg, orbit.elevation_deg) = (o.azimuth_deg, o.elevation_deg);
-            }
-            orbit.zoom = args.zoom;
-            let fov_deg = args.fov;
+            let (view, orbit) = args.look.view_and_orbit();
+            let fov_deg = args.look.fov;
             match args.fit {
                 FitFrames::First => CameraChoice::Fit {
                     view,
@@ -70,8 +62,8 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
             }
         }
     };
-    let legend_ink = args.geometry.legend.then(|| {
-        let [r, g, b] = background(args);
+    let legend_ink = args.look.geometry.legend.then(|| {
+        let [r, g, b] = background(&args.look);
         let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
         if luma > 128.0 {
             [0, 0, 0]
@@ -104,7 +96,7 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         pb.set_style(style);
     }
     pb.enable_steady_tick(std::time::Duration::from_millis(500));
-    let verbose = args.verbose;
+    let verbose = args.look.verbose;
     let follow = args.follow.then(|| FollowSettings {
         poll: Duration::from_secs_f64(args.poll),
         max_frames: args.max_frames,
@@ -193,7 +185,7 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         report.frames,
         path.display(),
         output.display(),
-        args.mode.name()
+        args.look.mode.name()
     );
     Ok(())
 }

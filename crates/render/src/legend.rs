@@ -132,8 +132,13 @@ fn outline(fb: &mut Framebuffer, [x0, y0, x1, y1]: [u32; 4], px: u32) {
     fill(fb, [x1, y0, x1 + 1, y1], px);
 }
 
-/// Draws `s` with its top-left corner at (x, y), each font pixel `scale`² screen pixels;
-/// characters outside the font are drawn as `?`.
+/// Draws `s` in the 8×8 font with its top-left corner at pixel (x, y), each font pixel
+/// `scale`² screen pixels, in the packed colour `px`; characters outside the font are drawn as
+/// `?`, pixels outside the frame are clipped.
+pub fn draw_text(fb: &mut Framebuffer, s: &str, x: u32, y: u32, scale: u32, px: u32) {
+    text(fb, s, x, y, scale, px)
+}
+
 fn text(fb: &mut Framebuffer, s: &str, x: u32, y: u32, scale: u32, px: u32) {
     for (i, c) in s.chars().enumerate() {
         let rows = font8x8::BASIC_FONTS

@@ -26,7 +26,7 @@ pub use driver::{
 };
 pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};
-pub use legend::{draw_legend, legend_label, Legend, LegendBox, MIN_LEGEND_FRAME};
+pub use legend::{draw_legend, draw_text, legend_label, Legend, LegendBox, MIN_LEGEND_FRAME};
 pub use progress::{render_frame_with_progress, PROGRESS_BANDS};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,

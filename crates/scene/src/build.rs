@@ -10,7 +10,7 @@ use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
     build_density, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells, MarchOptions,
-    Volume, VolumeScene,
+    TransferFunction, Volume, VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -240,6 +240,22 @@ impl Scene {
     /// vectors).
     pub(crate) fn scratch_bytes(&self) -> u64 {
         (self.scratch.0.capacity() * 4 + self.scratch.1.capacity() * 4) as u64
+    }
+
+    /// Replaces the volume's transfer function by `tf` (e.g. its opacity scaled) without
+    /// rebuilding the density: the classification is redone exactly as [`Scene::build`] does
+    /// it. Returns `false`, changing nothing, when there is no volume or a light volume was
+    /// built with the old one (then the scene must be rebuilt).
+    pub fn set_transfer_function(&mut self, tf: &TransferFunction) -> bool {
+        let (Some(d), Some(vs)) = (self.volume.as_mut(), self.settings.volume.as_mut()) else {
+            return false;
+        };
+        if self.light_volume.is_some() {
+            return false;
+        }
+        d.tf = ClassifiedTf::new(tf, 0.0, d.tf_max, vs.step_voxels);
+        vs.tf = tf.clone();
+        true
     }
 
     /// The marcher's view of the volume with options `opts`, with the light volume attached

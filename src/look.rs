@@ -1,0 +1,420 @@
+//! The flags of what a frame shows and how it is lit — size, mode, camera, style, volume,
+//! lighting, path tracing, performance — shared by `render` and `view`, and their mapping onto
+//! the typed [`SceneSettings`] and [`RenderSettings`] of the libraries.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use render::{
+    Camera, Material, Modality, RenderSettings, SecondaryTraversal, DARK_BACKGROUND,
+    HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
+};
+use scene::{LightVolumeSettings, Orbit, SceneSettings, Sphere, ViewPreset, LIGHT_VOLUME_STRIDE};
+use volume::{Light, Lighting, MarchOptions, TransferFunction, VolumeShadows};
+
+use crate::input::InputArgs;
+use crate::pipeline::{GeometryArgs, VolumeArgs};
+
+/// What a frame shows (the rows of the paper's Table 3).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Ball-and-stick, headlight diffuse shading.
+    Bs,
+    /// Direct volume rendering of the RBF density alone.
+    Volume,
+    /// Ball-and-stick, then the volume in front of it.
+    #[value(name = "vol+bs")]
+    VolBs,
+    /// Ball-and-stick, path traced (`--material`, `--spp`): progressive f32 accumulation.
+    Path,
+}
+
+impl Mode {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Bs => "bs",
+            Mode::Volume => "volume",
+            Mode::VolBs => "vol+bs",
+            Mode::Path => "path",
+        }
+    }
+}
+
+/// Three finite numbers `x,y,z`.
+fn vec3(s: &str) -> Option<[f32; 3]> {
+    let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
+    match v.as_slice() {
+        [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|a| a.is_finite()) => {
+            Some([*x, *y, *z])
+        }
+        _ => None,
+    }
+}
+
+/// Parses a direction `x,y,z` (not zero).
+fn parse_dir(s: &str) -> Result<[f32; 3], String> {
+    vec3(s)
+        .filter(|v| v.iter().any(|c| *c != 0.0))
+        .ok_or_else(|| format!("{s:?}: expected a non-zero direction x,y,z"))
+}
+
+/// Parses a positive finite number.
+fn positive(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .ok_or_else(|| format!("{s:?}: expected a positive number"))
+}
+
+/// Parses a finite number ≥ 0.
+fn non_negative(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| *v >= 0.0 && v.is_finite())
+        .ok_or_else(|| format!("{s:?}: expected a number ≥ 0"))
+}
+
+/// Parses a point `x,y,z` (Å).
+fn parse_point(s: &str) -> Result<[f32; 3], String> {
+    vec3(s).ok_or_else(|| format!("{s:?}: expected a point x,y,z in Å (three finite numbers)"))
+}
+
+/// What a frame shows and how (the flags `render` and `view` share).
+#[derive(Args, Debug, Clone)]
+pub struct LookArgs {
+    /// Image size, WIDTHxHEIGHT pixels.
+    #[arg(help_heading = "Output", long, default_value = "1024x1024", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// What to draw.
+    #[arg(help_heading = "Output", long, value_enum, default_value_t = Mode::Bs)]
+    pub mode: Mode,
+    /// Camera preset (ignored when --camera is given).
+    #[arg(help_heading = "Camera", long, value_enum, default_value_t = ViewPreset::Far)]
+    pub view: ViewPreset,
+    /// Orbit `AZ,EL` (degrees): the eye turned about +y by AZ and raised by EL around the
+    /// centre, instead of the preset's direction.
+    #[arg(help_heading = "Camera", long, allow_hyphen_values = true)]
+    pub orbit: Option<Orbit>,
+    /// Zoom factor of the preset's distance (2 = half as far).
+    #[arg(help_heading = "Camera", long, default_value_t = 1.0, value_parser = positive)]
+    pub zoom: f32,
+    /// Explicit camera: `eye=x,y,z:at=x,y,z[:up=x,y,z][:fov=deg][:ortho=height_Å]`.
+    #[arg(help_heading = "Camera", long)]
+    pub camera: Option<String>,
+    /// Vertical field of view of the presets (degrees).
+    #[arg(help_heading = "Camera", long, default_value_t = 45.0)]
+    pub fov: f32,
+    /// Background colour `r,g,b` (0-255; default white for bs, near-black for volume modes).
+    #[arg(help_heading = "Output", long, value_parser = parse_rgb)]
+    pub background: Option<[u8; 3]>,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
+    #[command(flatten)]
+    pub volume: VolumeArgs,
+    /// Transfer function: a preset (coolwarm, viridis, grayscale) or a file of control
+    /// points `value r g b a` (value from 0 to 1 over the density range).
+    #[arg(help_heading = "Volume", long, default_value = "coolwarm")]
+    pub tf: String,
+    /// Volume: multiply every opacity of the transfer function by this factor (clamped to 1).
+    #[arg(help_heading = "Volume", long, default_value_t = 1.0, value_parser = positive)]
+    pub opacity: f32,
+    /// Volume: gradient lighting by central differences (headlight, or from --light-dir /
+    /// --light-pos when given or when --volume-shadows is on).
+    #[arg(help_heading = "Volume", long)]
+    pub lit: bool,
+    /// Ball-and-stick (bs, vol+bs): diffuse light from --light-dir or --light-pos with hard
+    /// shadows.
+    #[arg(help_heading = "Lighting", long, conflicts_with = "ao")]
+    pub shadows: bool,
+    /// Ball-and-stick (bs, vol+bs): ambient occlusion with N cosine-distributed rays per hit.
+    #[arg(help_heading = "Lighting", long, value_name = "N")]
+    pub ao: Option<u32>,
+    /// Ambient occlusion distance (Å).
+    #[arg(help_heading = "Lighting", long, default_value_t = 4.0, value_parser = positive)]
+    pub ao_distance: f32,
+    /// Direction towards a directional light, world space `x,y,z` (default 1,2,1.5).
+    #[arg(help_heading = "Lighting", long, value_parser = parse_dir, conflicts_with = "light_pos", allow_hyphen_values = true)]
+    pub light_dir: Option<[f32; 3]>,
+    /// Position of a point light instead, world space `x,y,z` in Å (no distance fall-off).
+    #[arg(help_heading = "Lighting", long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub light_pos: Option<[f32; 3]>,
+    /// Light intensity (shadows: factor of max(0, n·l); path: irradiance / π).
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.85)]
+    pub light_intensity: f32,
+    /// Ambient term of --shadows shading.
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.2)]
+    pub ambient: f32,
+    /// The volume casts shadows (paper §4.5, Figure 4): with --mode volume every visible
+    /// sample is shadowed by the density towards the light; with --mode vol+bs --shadows also
+    /// the balls and sticks (soft shadows).
+    #[arg(help_heading = "Volume", long)]
+    pub volume_shadows: bool,
+    /// Step of shadow rays through the volume (voxels).
+    #[arg(help_heading = "Volume", long, default_value_t = 2.0)]
+    pub shadow_step: f32,
+    /// Volumetric shadows: march a shadow ray from every shaded volume sample instead of
+    /// looking up the light volume precomputed every 2 voxels (slower; the reference).
+    #[arg(help_heading = "Volume", long)]
+    pub shadow_rays: bool,
+    /// Path tracing: BRDF of the atoms.
+    #[arg(help_heading = "Path tracing", long, value_enum, default_value_t = Material::Metal)]
+    pub material: Material,
+    /// Path tracing: samples per pixel.
+    #[arg(help_heading = "Path tracing", long, default_value_t = 16)]
+    pub spp: u32,
+    /// Path tracing: maximum hits per path.
+    #[arg(help_heading = "Path tracing", long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_depth: u32,
+    /// Path tracing, metal: roughness (0 = mirror).
+    #[arg(help_heading = "Path tracing", long, default_value_t = 0.15, value_parser = non_negative)]
+    pub roughness: f32,
+    /// Path tracing: exposure (radiance multiplier before clamp and gamma 2).
+    #[arg(help_heading = "Path tracing", long, default_value_t = 1.0)]
+    pub exposure: f32,
+    /// Seed of the random numbers of AO and path tracing (`--seed` seeds scene generators).
+    #[arg(help_heading = "Path tracing", long, default_value_t = 1)]
+    pub sample_seed: u32,
+    /// Traversal of shadow and AO rays (and the path tracer's light samples): packets with
+    /// any-hit exit, single rays, or single rays over the 8-wide BVH.
+    #[arg(help_heading = "Performance", long, value_enum, default_value_t = SecondaryTraversal::Packet)]
+    pub secondary: SecondaryTraversal,
+    /// Traversal of the path tracer's bounced rays (camera rays always go in packets).
+    #[arg(help_heading = "Path tracing", long, value_enum, default_value_t = SecondaryTraversal::Wide)]
+    pub bounce_traversal: SecondaryTraversal,
+    /// Volume: march every cell (no macrocell skipping), for comparison.
+    #[arg(help_heading = "Volume", long)]
+    pub no_macrocells: bool,
+    /// Volume: post-classification instead of pre-integration, for comparison.
+    #[arg(help_heading = "Volume", long)]
+    pub no_preintegration: bool,
+    /// Worker threads (default: all cores).
+    #[arg(help_heading = "Performance", long)]
+    pub threads: Option<usize>,
+    /// Print timings of every stage and the ISA to stderr.
+    #[arg(help_heading = "Output", short, long)]
+    pub verbose: bool,
+}
+
+impl LookArgs {
+    /// Sets the size of rayon's global pool from `--threads` (refused beyond 16 per core).
+    pub fn init_threads(&self) -> Result<()> {
+        if let Some(n) = self.threads {
+            // More threads than this per core only add overhead (and a stack each).
+            let cap = 16 * std::thread::available_parallelism().map_or(1, |c| c.get());
+            if n == 0 || n > cap {
+                bail!("--threads {n}: use 1 to {cap} (16 per core on this machine)");
+            }
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build_global()
+                .context("--threads")?;
+        }
+        Ok(())
+    }
+
+    /// The transfer function of `--tf` with `--opacity` applied, for the modes that draw the
+    /// volume (`None` for bs and path).
+    pub fn transfer_function(&self) -> Result<Option<TransferFunction>> {
+        Ok(match self.mode {
+            Mode::Bs | Mode::Path => None,
+            Mode::Volume | Mode::VolBs => {
+                let tf = TransferFunction::from_spec(&self.tf)?;
+                Some(if self.opacity == 1.0 {
+                    tf
+                } else {
+                    tf.scale_opacity(self.opacity)
+                })
+            }
+        })
+    }
+
+    /// The camera of the flags: `--camera`, else the preset fitted to `sphere` with `--orbit`,
+    /// `--zoom` and `--fov` at the aspect of `--size`.
+    pub fn camera(&self, sphere: Sphere) -> Result<Camera> {
+        if let Some(spec) = &self.camera {
+            return Ok(spec.parse::<Camera>()?);
+        }
+        let (view, orbit) = self.view_and_orbit();
+        let (w, h) = self.size;
+        Ok(Camera::fit(
+            view,
+            sphere,
+            self.fov,
+            w as f32 / h as f32,
+            orbit,
+        ))
+    }
+
+    /// The preset's distance and the orbit of `--view`, `--orbit` and `--zoom`.
+    pub fn view_and_orbit(&self) -> (scene::View, Orbit) {
+        let (view, mut orbit) = self.view.view_and_orbit();
+        if let Some(o) = self.orbit {
+            (orbit.azimuth_deg, orbit.elevation_deg) = (o.azimuth_deg, o.elevation_deg);
+        }
+        orbit.zoom = self.zoom;
+        (view, orbit)
+    }
+}
+
+/// Parses `WIDTHxHEIGHT`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 1024x1024"))?;
+    let p = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    match (p(w), p(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("{s:?}: width and height must be positive integers")),
+    }
+}
+
+fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
+    let v: Vec<Option<u8>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
+    match v.as_slice() {
+        [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b]),
+        _ => Err(format!("{s:?}: expected r,g,b with each 0-255")),
+    }
+}
+
+/// What `render` builds for the flags: the model unless `--mode volume`, the volume with
+/// `tf` (given for the volume modes) and its light volume for volumetric shadows unless
+/// `--shadow-rays`, the wide BVH when secondary or bounced rays use it.
+pub(crate) fn scene_settings(
+    args: &LookArgs,
+    input: &InputArgs,
+    tf: Option<TransferFunction>,
+) -> Result<SceneSettings> {
+    let model = if args.mode == Mode::Volume {
+        None
+    } else {
+        let mut ms = args.geometry.settings()?;
+        ms.periodic_bonds = input.pbc;
+        ms.wide_bvh = modality(args) != Modality::Headlight
+            && (args.secondary == SecondaryTraversal::Wide
+                || (args.mode == Mode::Path && args.bounce_traversal == SecondaryTraversal::Wide));
+        Some(ms)
+    };
+    let volume = match tf {
+        Some(tf) => {
+            let shadows = march_options(args).shadows.filter(|_| !args.shadow_rays);
+            Some(scene::VolumeSettings {
+                tf,
+                light_volume: shadows.map(|sh| LightVolumeSettings {
+                    light: sh.light,
+                    step_voxels: sh.step_voxels,
+                    stride: LIGHT_VOLUME_STRIDE,
+                }),
+                ..args.volume.settings()?
+            })
+        }
+        None => None,
+    };
+    Ok(SceneSettings {
+        model,
+        bonds: input.bond_settings()?,
+        volume,
+        budget_bytes: None,
+        frame: Some(args.size),
+    })
+}
+
+/// Background colour: `--background`, else white for `bs` and near-black for the others.
+pub(crate) fn background(args: &LookArgs) -> [u8; 3] {
+    args.background.unwrap_or(if args.mode == Mode::Bs {
+        WHITE_BACKGROUND
+    } else {
+        DARK_BACKGROUND
+    })
+}
+
+/// The light of the flags: `--light-pos`, else `--light-dir`, else the default direction.
+pub(crate) fn light(args: &LookArgs) -> Light {
+    match (args.light_pos, args.light_dir) {
+        (Some(p), _) => Light::Point(p),
+        (None, Some(d)) => Light::Directional(d),
+        (None, None) => RenderSettings::default().light,
+    }
+}
+
+/// The volume marcher's options from the flags: lighting (headlight unless a light is given
+/// or shadows need one), volumetric shadows, macrocells and pre-integration.
+pub(crate) fn march_options(args: &LookArgs) -> MarchOptions {
+    let explicit = args.light_pos.is_some() || args.light_dir.is_some() || args.volume_shadows;
+    let lighting = match (args.lit, explicit, light(args)) {
+        (false, _, _) => Lighting::Unlit,
+        (true, false, _) => Lighting::Headlight,
+        (true, true, Light::Directional(d)) => Lighting::Directional(d),
+        (true, true, Light::Point(p)) => Lighting::Point(p),
+    };
+    MarchOptions {
+        macrocells: !args.no_macrocells,
+        preintegrated: !args.no_preintegration,
+        lighting,
+        shadows: args.volume_shadows.then(|| VolumeShadows {
+            light: light(args),
+            step_voxels: args.shadow_step,
+        }),
+        ..MarchOptions::default()
+    }
+}
+
+/// Every render option of the flags as one [`RenderSettings`] (headlight modes: ambient
+/// [`render::HEADLIGHT_AMBIENT`]; `--ambient` is the ambient term of the traced modalities).
+pub(crate) fn render_settings(args: &LookArgs) -> RenderSettings {
+    let modality = modality(args);
+    RenderSettings {
+        modality,
+        march: march_options(args),
+        light: light(args),
+        light_intensity: args.light_intensity,
+        ambient: if modality == Modality::Headlight {
+            HEADLIGHT_AMBIENT
+        } else {
+            args.ambient
+        },
+        background: background(args),
+        exposure: args.exposure,
+        seed: args.sample_seed,
+        spp: if args.mode == Mode::Path { args.spp } else { 1 },
+        volume_shadows: args.volume_shadows,
+        shadow_step_voxels: args.shadow_step,
+        secondary: args.secondary,
+        bounces: args.bounce_traversal,
+        packet_registers: 0,
+    }
+}
+
+/// Rejects combinations of modality flags that do nothing, with what to use instead: the
+/// flag conflicts here, every rule on the resulting settings in [`RenderSettings::validate`].
+pub(crate) fn check_modalities(args: &LookArgs) -> Result<()> {
+    if (args.shadows || args.ao.is_some()) && args.mode == Mode::Path {
+        // The path tracer has its own lighting: these flags would be ignored.
+        return Err(render::SettingsError::NeedsModel.into());
+    }
+    let has_model = args.mode != Mode::Volume;
+    let has_volume = matches!(args.mode, Mode::Volume | Mode::VolBs);
+    Ok(render_settings(args).validate(has_model, has_volume)?)
+}
+
+/// The modality the flags ask for (`Headlight`: the plain b&s / volume / vol+bs modes).
+pub(crate) fn modality(args: &LookArgs) -> Modality {
+    if args.mode == Mode::Path {
+        return Modality::Path {
+            material: args.material,
+            max_depth: args.max_depth,
+            roughness: args.roughness,
+        };
+    }
+    if let Some(n) = args.ao {
+        return Modality::Ao {
+            samples: n,
+            distance: args.ao_distance,
+        };
+    }
+    if args.shadows {
+        return Modality::Direct { shadows: true };
+    }
+    Modality::Headlight
+}

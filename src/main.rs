@@ -14,6 +14,7 @@ mod pipeline;
 mod progress;
 mod render_cmd;
 mod series_cmd;
+mod view_cmd;
 
 /// Ray traces ball-and-stick and volume renderings of molecular-dynamics data on the CPU,
 /// with SIMD kernels compiled for SSE4.1, AVX2 and AVX-512 and chosen at run time.
@@ -42,6 +43,9 @@ enum Command {
     Info(info::InfoArgs),
     /// Render a molecule file or a built-in scene (default: nanobowl) to a PNG.
     Render(Box<render_cmd::RenderArgs>),
+    /// Open a window on a molecule file or a built-in scene: fly with the mouse, switch modes
+    /// and lighting with keys (h lists them), play the time steps; --script drives it headless.
+    View(Box<view_cmd::ViewArgs>),
     /// Write a built-in reference scene to a file (.xyz or .lammpstrj, optionally .gz).
     Generate(generate::GenerateArgs),
     /// Reproduce the paper's Tables 1-3 on this machine: preprocessing figures and fps per
@@ -92,6 +96,7 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Isa) => isa_cmd::run(isa),
         Some(Command::Info(args)) => info::run(args),
         Some(Command::Render(args)) => render_cmd::run(*args, isa),
+        Some(Command::View(args)) => view_cmd::run(*args, isa),
         Some(Command::Generate(args)) => generate::run(args),
         Some(Command::Bench(args)) => {
             let isas = match cli.isa {

@@ -1,0 +1,213 @@
+//! The background loader: reads and builds the scene of a time step on its own thread and
+//! its own thread pool, at the lowest scheduling priority, so the window thread never waits
+//! for a build and its frames keep their speed; the window polls for the result and swaps it
+//! in when it is ready.
+
+use std::sync::mpsc::{channel, Receiver, Sender, TryRecvError};
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use molecule::read::Trajectory;
+use molecule::Molecule;
+use scene::{Scene, SceneSettings};
+use spmd::Isa;
+
+/// Where the time steps come from.
+pub enum FrameSource {
+    /// A trajectory file (random access after its frames are counted).
+    File(Box<Trajectory>),
+    /// One frame already in memory (a built-in scene or a single-frame file), with its name.
+    One(Box<Molecule>, String),
+}
+
+impl FrameSource {
+    /// Human name of the source.
+    pub fn name(&self) -> String {
+        match self {
+            FrameSource::File(t) => t.path().display().to_string(),
+            FrameSource::One(_, n) => n.clone(),
+        }
+    }
+
+    fn count(&mut self) -> Result<usize, String> {
+        match self {
+            FrameSource::File(t) => t.count_frames().map_err(|e| e.to_string()),
+            FrameSource::One(..) => Ok(1),
+        }
+    }
+
+    fn read(&mut self, k: usize) -> Result<Molecule, String> {
+        match self {
+            FrameSource::File(t) => t.read_frame(k).map_err(|e| e.to_string()),
+            FrameSource::One(m, _) if k == 0 => Ok((**m).clone()),
+            FrameSource::One(_, n) => Err(format!("{n}: has one frame, no frame {k}")),
+        }
+    }
+}
+
+/// A scene to build.
+#[derive(Clone)]
+pub struct Request {
+    /// Which request this is (answers carry it back).
+    pub id: u64,
+    /// Time step (0-based).
+    pub frame: usize,
+    /// What the scene holds.
+    pub settings: SceneSettings,
+}
+
+/// What the loader sends back.
+pub enum Answer {
+    /// The scene of a request (or why it could not be made).
+    Built {
+        /// The request's id.
+        id: u64,
+        /// Its time step.
+        frame: usize,
+        /// The scene.
+        scene: Result<Box<Scene>, String>,
+        /// Seconds reading the frame.
+        read_s: f64,
+        /// Seconds building the scene.
+        build_s: f64,
+    },
+    /// A request dropped for a newer one before it was started.
+    Skipped {
+        /// The request's id.
+        id: u64,
+    },
+    /// How many time steps the source has (counted after the first scene is built).
+    Frames(Result<usize, String>),
+}
+
+/// The loader thread and its channels.
+pub struct Loader {
+    tx: Option<Sender<Request>>,
+    rx: Receiver<Answer>,
+    pending: usize,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl Loader {
+    /// Starts the loader over `source` with a pool of `threads` build threads.
+    pub fn start(source: FrameSource, isa: Isa, threads: usize) -> Loader {
+        let (tx, requests) = channel::<Request>();
+        let (answers, rx) = channel();
+        let handle = std::thread::Builder::new()
+            .name("bnsview-loader".into())
+            .spawn(move || serve(source, isa, threads, requests, answers))
+            .ok();
+        Loader {
+            tx: Some(tx),
+            rx,
+            pending: 0,
+            handle,
+        }
+    }
+
+    /// Asks for a scene; requests made before it that are not started yet are dropped.
+    pub fn request(&mut self, r: Request) {
+        if let Some(tx) = &self.tx {
+            if tx.send(r).is_ok() {
+                self.pending += 1;
+            }
+        }
+    }
+
+    /// An answer, if one is ready (never waits).
+    pub fn poll(&mut self) -> Option<Answer> {
+        match self.rx.try_recv() {
+            Ok(a) => {
+                if let Answer::Built { .. } | Answer::Skipped { .. } = a {
+                    self.pending = self.pending.saturating_sub(1);
+                }
+                Some(a)
+            }
+            Err(TryRecvError::Empty) => None,
+            Err(TryRecvError::Disconnected) => {
+                self.pending = 0;
+                None
+            }
+        }
+    }
+
+    /// Whether a requested scene has not arrived yet.
+    pub fn busy(&self) -> bool {
+        self.pending > 0
+    }
+}
+
+impl Drop for Loader {
+    fn drop(&mut self) {
+        self.tx = None;
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// Lowers the calling thread's scheduling priority to the lowest (nice 19), so that while the
+/// window renders, builds take only the CPU time the frames leave.
+fn yield_to_the_window() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: setpriority only reads its three integer arguments; on Linux `who` = 0 with
+    // PRIO_PROCESS names the calling thread, so only this thread's nice value changes. A
+    // failure (e.g. forbidden by a policy) leaves the priority as it was, which is harmless.
+    unsafe {
+        libc::setpriority(libc::PRIO_PROCESS, 0, 19);
+    }
+}
+
+/// The loader thread: the newest request first (older waiting ones are answered as
+/// skipped), read, build on the loader's own pool, send.
+fn serve(
+    mut source: FrameSource,
+    isa: Isa,
+    threads: usize,
+    requests: Receiver<Request>,
+    answers: Sender<Answer>,
+) {
+    yield_to_the_window();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .thread_name(|i| format!("bnsview-build-{i}"))
+        .start_handler(|_| yield_to_the_window())
+        .build();
+    let mut counted = false;
+    while let Ok(mut r) = requests.recv() {
+        // Only the newest waiting request matters; the others are answered as skipped.
+        while let Ok(newer) = requests.try_recv() {
+            if answers.send(Answer::Skipped { id: r.id }).is_err() {
+                return;
+            }
+            r = newer;
+        }
+        let t = Instant::now();
+        let m = source.read(r.frame);
+        let read_s = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let scene = m.and_then(|m| {
+            let build = || Scene::build(isa, &m, &r.settings).map_err(|e| e.to_string());
+            match &pool {
+                Ok(p) => p.install(build),
+                Err(_) => build(),
+            }
+        });
+        let answer = Answer::Built {
+            id: r.id,
+            frame: r.frame,
+            scene: scene.map(Box::new),
+            read_s,
+            build_s: t.elapsed().as_secs_f64(),
+        };
+        if answers.send(answer).is_err() {
+            return;
+        }
+        if !counted {
+            counted = true;
+            if answers.send(Answer::Frames(source.count())).is_err() {
+                return;
+            }
+        }
+    }
+}

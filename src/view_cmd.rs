@@ -1,0 +1,129 @@
+//! `bnsview view`: the interactive window over a file or a built-in scene.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use molecule::read::{open, FrameIndex};
+use spmd::Isa;
+use viewer::{FrameSource, Toggles, ViewConfig, ViewMode};
+
+use crate::input::InputArgs;
+use crate::look::{check_modalities, render_settings, scene_settings, LookArgs, Mode};
+
+/// Arguments of `bnsview view`.
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Drive the viewer from a file of commands, one per line (`orbit AZ EL`, `pan DX DY`,
+    /// `zoom F`, `key NAME`, `frame K`, `wait-frames N`, `wait-still`, `screenshot FILE`,
+    /// `quit`); the window works as usual meanwhile.
+    #[arg(help_heading = "Viewer", long, value_name = "FILE")]
+    pub script: Option<PathBuf>,
+    /// Write one JSON line per presented frame (time, time step, mode, preview scale,
+    /// samples, render time, whether a scene was loading) and per key to this file.
+    #[arg(help_heading = "Viewer", long, value_name = "FILE")]
+    pub log: Option<PathBuf>,
+    /// Render every frame at full resolution, also while the camera moves (benchmarks).
+    #[arg(help_heading = "Viewer", long)]
+    pub no_preview: bool,
+    /// Screenshots may overwrite existing files.
+    #[arg(help_heading = "Viewer", short, long)]
+    pub force: bool,
+    /// AO rays per hit when the `a` key switches ambient occlusion on (default: --ao, else 8).
+    #[arg(help_heading = "Viewer", long, value_name = "N")]
+    pub ao_key_samples: Option<u32>,
+    #[command(flatten)]
+    pub look: LookArgs,
+}
+
+fn view_mode(m: Mode) -> ViewMode {
+    match m {
+        Mode::Bs => ViewMode::Bs,
+        Mode::Volume => ViewMode::Volume,
+        Mode::VolBs => ViewMode::VolBs,
+        Mode::Path => ViewMode::Path,
+    }
+}
+
+fn mode(m: ViewMode) -> Mode {
+    match m {
+        ViewMode::Bs => Mode::Bs,
+        ViewMode::Volume => Mode::Volume,
+        ViewMode::VolBs => Mode::VolBs,
+        ViewMode::Path => Mode::Path,
+    }
+}
+
+/// Run `bnsview view`.
+pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
+    args.look.init_threads()?;
+    check_modalities(&args.look)?;
+    if args.look.geometry.legend {
+        bail!("--legend is drawn by `bnsview render` only; the viewer's screenshots have none");
+    }
+    let script = match &args.script {
+        Some(p) => Some(viewer::script::load(p)?),
+        None => None,
+    };
+    let mut input = args.input.clone();
+    if input.file.is_none() && input.scene.is_none() {
+        input.scene = Some(molecule::scenes::SceneName::Nanobowl);
+    }
+    let (source, first_frame) = match &input.file {
+        Some(path) => {
+            let mut t = open(path, &input.read_options()?)?;
+            let first = t.resolve_frame(FrameIndex::from(input.frame))?;
+            (FrameSource::File(Box::new(t)), first)
+        }
+        None => {
+            let l = input.load_frame(false)?;
+            (FrameSource::One(Box::new(l.molecule), l.source), 0)
+        }
+    };
+    let toggles = Toggles {
+        mode: view_mode(args.look.mode),
+        shadows: args.look.shadows,
+        ao: args.look.ao,
+        lit: args.look.lit,
+        opacity: args.look.opacity,
+    };
+    let look = args.look.clone();
+    let inp = input.clone();
+    // The viewer's toggles set on a copy of the flags: every frame is what `render` makes
+    // of the same flags.
+    let configure = move |t: &Toggles| {
+        let mut a = look.clone();
+        (a.mode, a.shadows, a.ao, a.lit, a.opacity) =
+            (mode(t.mode), t.shadows, t.ao, t.lit, t.opacity);
+        check_modalities(&a).map_err(|e| e.to_string())?;
+        let tf = a.transfer_function().map_err(|e| e.to_string())?;
+        let scene = scene_settings(&a, &inp, tf).map_err(|e| e.to_string())?;
+        Ok((scene, render_settings(&a)))
+    };
+    let look = args.look.clone();
+    let cfg = ViewConfig {
+        size: args.look.size,
+        isa,
+        toggles,
+        ao_samples: args.ao_key_samples.or(args.look.ao).unwrap_or(8),
+        configure: Box::new(configure),
+        camera: Box::new(move |sphere| look.camera(sphere).map_err(|e| e.to_string())),
+        first_frame,
+        script,
+        log: args.log.clone(),
+        force: args.force,
+        build_threads: (rayon::current_num_threads() / 2).max(1),
+        preview: !args.no_preview,
+    };
+    let report = viewer::run(cfg, source).context("bnsview view")?;
+    if args.look.verbose {
+        eprintln!(
+            "view: {} frames presented, {} screenshot(s)",
+            report.presented,
+            report.screenshots.len()
+        );
+    }
+    Ok(())
+}

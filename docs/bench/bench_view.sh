@@ -57,8 +57,9 @@ gaps = [b['t'] - a['t'] for a, b in zip(p, p[1:]) if b['loading']]
 rs = sorted(l['render_s'] for l in p)
 loads = [l for l in L if 'loaded' in l][1:]
 gs = sorted(gaps)
+wait = max(b['t'] - a['t'] - b['render_s'] for a, b in zip(p, p[1:]) if b['loading'])
 print(f"{sys.argv[2]}²: {len(p)} orbit frames, {len(gaps)} during builds (median gap {gs[len(gs) // 2]:.3f} s); builds {', '.join('%.2f' % l['build_s'] for l in loads)} s; "
-      f"longest gap during a build {max(gaps):.3f} s, median render {rs[len(rs) // 2]:.3f} s")
+      f"longest gap during a build {max(gaps):.3f} s, median render {rs[len(rs) // 2]:.3f} s, longest wait beyond a frame's own render {1e3 * wait:.1f} ms")
 PY
   done
 fi

@@ -317,6 +317,9 @@ impl App {
                 println!("--camera '{}' {}", self.nav.spec(), self.toggles.flags())
             }
             Action::Screenshot => self.screenshot(None)?,
+            Action::PlayPause if self.frames == Some(1) => {
+                self.say("one time step: nothing to play".into());
+            }
             Action::PlayPause => {
                 self.playing = !self.playing;
                 let at_end = match (&self.shown, self.frames) {
@@ -721,5 +724,76 @@ fn fix_ranges(s: &mut SceneSettings, (color, density): Ranges) {
     }
     if let Some(vs) = s.volume.as_mut() {
         vs.density_max = vs.density_max.or(density);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use molecule::scenes::{try_generate, SceneName};
+    use scene::{ModelSettings, VolumeSettings};
+
+    #[test]
+    fn a_scene_serves_what_it_holds_and_only_that() {
+        let m = try_generate(SceneName::Nanobowl, Some(400), 1).unwrap();
+        let both = SceneSettings {
+            volume: Some(VolumeSettings {
+                voxels_per_angstrom: 1.0,
+                ..VolumeSettings::default()
+            }),
+            ..SceneSettings::default()
+        };
+        let isa = Isa::detect();
+        let mut sc = Scene::build(isa, &m, &both).unwrap();
+        let bs = SceneSettings {
+            volume: None,
+            ..both.clone()
+        };
+        let volume = SceneSettings {
+            model: None,
+            ..both.clone()
+        };
+        assert!(matches!(fit(&sc, &both), Fit::Serves));
+        assert!(matches!(fit(&sc, &bs), Fit::Serves));
+        assert!(matches!(fit(&sc, &volume), Fit::Serves));
+        // The wide BVH is built on demand: it does not call for a rebuild.
+        let wide = SceneSettings {
+            model: Some(ModelSettings {
+                wide_bvh: true,
+                ..ModelSettings::default()
+            }),
+            ..bs.clone()
+        };
+        assert!(matches!(fit(&sc, &wide), Fit::Serves));
+        // Other balls do.
+        let fat = SceneSettings {
+            model: Some(ModelSettings {
+                radius_scale: 0.8,
+                ..ModelSettings::default()
+            }),
+            ..bs.clone()
+        };
+        assert!(matches!(fit(&sc, &fat), Fit::Rebuild));
+        // Another opacity re-classifies the transfer function, as a build with it would.
+        let mut opaque = both.clone();
+        let vs = opaque.volume.as_mut().unwrap();
+        vs.tf = vs.tf.clone().scale_opacity(2.0);
+        let Fit::NewTf(tf) = fit(&sc, &opaque) else {
+            panic!("expected a new transfer function");
+        };
+        assert!(sc.set_transfer_function(&tf));
+        let built = Scene::build(isa, &m, &opaque).unwrap();
+        let (a, b) = (
+            &sc.volume.as_ref().unwrap().tf,
+            &built.volume.as_ref().unwrap().tf,
+        );
+        assert_eq!(
+            (&a.preint, &a.post, &a.range_max),
+            (&b.preint, &b.post, &b.range_max)
+        );
+        assert!(matches!(fit(&sc, &opaque), Fit::Serves));
+        // A scene without a volume serves no volume.
+        let only_bs = Scene::build(isa, &m, &bs).unwrap();
+        assert!(matches!(fit(&only_bs, &volume), Fit::Rebuild));
     }
 }

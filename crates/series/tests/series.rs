@@ -119,24 +119,18 @@ fn bad_outputs_and_empty_ranges_are_refused() {
     let no_column = settings(FrameRange::ALL, true);
     assert!(render_series(&mut traj, &no_column, &mut sink, &mut |_| {}).is_err());
     assert!(!gif.exists());
+    // The error of opening the sink for `name` in scratch.
+    let open_err = |name: &str| {
+        Sink::open(&OutputKind::from_path(&d.join(name)).unwrap(), false, 10.0)
+            .err()
+            .unwrap()
+    };
     // A numbered output in a missing directory is refused before any frame, once.
-    let e = Sink::open(
-        &OutputKind::from_path(&d.join("nodir/f_%05d.png")).unwrap(),
-        false,
-        10.0,
-    )
-    .err()
-    .unwrap();
+    let e = open_err("nodir/f_%05d.png");
     assert!(matches!(e, SeriesError::NoDirectory { .. }), "{e}");
     assert!(e.to_string().contains("nodir"), "{e}");
     // A file-system error says its cause once, in the message, not again as a source.
-    let e = Sink::open(
-        &OutputKind::from_path(&d.join("nodir/m.gif")).unwrap(),
-        false,
-        10.0,
-    )
-    .err()
-    .unwrap();
+    let e = open_err("nodir/m.gif");
     assert!(std::error::Error::source(&e).is_none(), "{e}");
     assert!(e.to_string().contains("m.gif"), "{e}");
     // A range past the end of the file.

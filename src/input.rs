@@ -190,7 +190,7 @@ impl InputArgs {
                 None => spinner(&what),
             };
             let read = t.decoded_counter();
-            let m = follow_bytes(&pb, read.clone(), &what, || {
+            let m = follow_bytes(&pb, &read, &what, || {
                 t.read_frame_at(FrameIndex::from(self.frame))
             })?;
             let frames = if count_frames {
@@ -199,7 +199,7 @@ impl InputArgs {
                 if let Some(n) = bytes.filter(|_| !t.is_gzip()) {
                     pb.set_length(n + before);
                 }
-                follow_bytes(&pb, read, "counting frames", || t.count_frames())?
+                follow_bytes(&pb, &read, "counting frames", || t.count_frames())?
             } else {
                 0
             };

@@ -1,13 +1,13 @@
 //! Progress on stderr for the steps that can take a while: spinners for steps of unknown
-//! length, bars for reading a file and rendering a frame. Nothing is drawn when stderr is not a
+//! length, bars for reading a file, each stage of a scene build and rendering a frame. Nothing is drawn when stderr is not a
 //! terminal, and nothing before half a second has passed.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, RecvTimeoutError};
-use std::sync::Arc;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use scene::{Progress, Stage};
 
 /// A spinner with `msg` and the time elapsed.
 pub fn spinner(msg: &str) -> ProgressBar {
@@ -40,12 +40,11 @@ pub fn bar(msg: &str, len: u64, bytes: bool) -> ProgressBar {
 /// the bar has a length, else in its message after `what`.
 pub fn follow_bytes<T>(
     pb: &ProgressBar,
-    read: Arc<AtomicU64>,
+    read: &AtomicU64,
     what: &str,
     work: impl FnOnce() -> T,
 ) -> T {
     let (done, wait) = channel::<()>();
-    let read = &read;
     std::thread::scope(|s| {
         s.spawn(move || loop {
             let b = read.load(Ordering::Relaxed);
@@ -63,4 +62,26 @@ pub fn follow_bytes<T>(
         drop(done);
         out
     })
+}
+
+/// Runs `work` (a scene build) with a bar per stage: `work` reports through the
+/// [`Progress`] it is given, each stage restarts the bar with its name and units.
+pub fn follow_build<T>(work: impl FnOnce(&Progress) -> T) -> T {
+    let pb = bar("building the scene", 1, false);
+    let done = AtomicU64::new(0);
+    let stage = |s: Stage, units: u64| {
+        // Zero the count before the bar's length changes, so no poll shows the last
+        // stage's count against this one's length.
+        done.store(0, Ordering::Relaxed);
+        pb.set_message(format!("building the scene: {s}"));
+        pb.reset();
+        pb.set_length(units.max(1));
+    };
+    let progress = Progress {
+        stage: &stage,
+        done: &done,
+    };
+    let out = follow_bytes(&pb, &done, "", || work(&progress));
+    pb.finish_and_clear();
+    out
 }

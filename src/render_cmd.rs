@@ -143,11 +143,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         m.len()
     ));
     let settings = scene_settings(&args.look, &input, tf)?;
-    let pb = crate::progress::spinner("building the scene");
-    let sc = Scene::build_with(isa, m, &settings, &|st| {
-        pb.set_message(format!("building the scene: {st:?}"))
-    })?;
-    pb.finish_and_clear();
+    let sc = crate::progress::follow_build(|p| Scene::build_with(isa, m, &settings, p))?;
     sc.stage_report().into_iter().for_each(verbose);
     // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
     // support, when there is no geometry).

@@ -1,6 +1,7 @@
 //! BVH builders: binned SAH, parallel over subtrees (the fast one), and the paper's full-sweep
 //! SAH over presorted lists (§4.1, the quality reference).
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use glam::Vec3A;
@@ -416,7 +417,8 @@ enum Skeleton {
 }
 
 /// Builds the tree over `refs` (primitive slots from `ref_base`): rayon over subtrees while
-/// both sides have at least [`PAR_SUBTREE`] primitives, then sequentially.
+/// both sides have at least [`PAR_SUBTREE`] primitives, then sequentially, adding the
+/// primitives of each finished sequential subtree to `done`.
 fn build_skeleton(
     refs: &mut [PrimRef],
     ref_base: usize,
@@ -424,6 +426,7 @@ fn build_skeleton(
     cb: Aabb,
     nb: usize,
     pre: Option<Box<Binned>>,
+    done: &AtomicU64,
 ) -> Skeleton {
     let n = refs.len();
     if n >= 2 * PAR_SUBTREE {
@@ -432,8 +435,8 @@ fn build_skeleton(
         let (lrefs, rrefs) = refs.split_at_mut(nl);
         if nl >= PAR_SUBTREE && n - nl >= PAR_SUBTREE {
             let (l, r) = rayon::join(
-                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, nb, lpre),
-                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre),
+                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, nb, lpre, done),
+                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, done),
             );
             return Skeleton::Inner {
                 bounds,
@@ -450,11 +453,13 @@ fn build_skeleton(
         nodes.extend([root, Node::default(), Node::default()]);
         build_seq(lrefs, ref_base, s.lb, s.lcb, nb, lpre, &mut nodes, 1);
         build_seq(rrefs, ref_base + nl, s.rb, s.rcb, nb, rpre, &mut nodes, 2);
+        done.fetch_add(n as u64, Ordering::Relaxed);
         return Skeleton::Local(nodes);
     }
     let mut nodes = Vec::with_capacity(n);
     nodes.push(Node::default());
     build_seq(refs, ref_base, bounds, cb, nb, pre, &mut nodes, 0);
+    done.fetch_add(n as u64, Ordering::Relaxed);
     Skeleton::Local(nodes)
 }
 
@@ -547,6 +552,13 @@ impl Bvh {
 
     /// Binned SAH build (§4.1 step 4, binned as in Wald 2007 instead of the paper's sweep).
     pub fn build_with(g: &Geometry, opt: &BuildOptions) -> Bvh {
+        Bvh::build_with_progress(g, opt, &AtomicU64::new(0))
+    }
+
+    /// [`Bvh::build_with`] adding to `done` the primitives placed in finished subtrees (it
+    /// reaches [`Geometry::prim_count`] when the tree is built), for a progress display that
+    /// reads it from another thread.
+    pub fn build_with_progress(g: &Geometry, opt: &BuildOptions, done: &AtomicU64) -> Bvh {
         let start = Instant::now();
         let nb = opt.bins.clamp(2, MAX_BINS);
         let (mut refs, bounds, cb) = prim_refs(g);
@@ -554,7 +566,7 @@ impl Bvh {
         let nodes = if n == 0 {
             vec![Node::default()]
         } else {
-            let sk = build_skeleton(&mut refs, 0, bounds, cb, nb, None);
+            let sk = build_skeleton(&mut refs, 0, bounds, cb, nb, None, done);
             assemble(sk, n)
         };
         let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();

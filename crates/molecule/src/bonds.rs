@@ -12,6 +12,8 @@
 //! image (so bonds across the boundary connect to the nearest image and never span the box);
 //! this assumes the cutoff is below half of each periodic box width.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use crate::elements;
 use crate::Molecule;
 use rayon::prelude::*;
@@ -396,7 +398,7 @@ pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
         return Vec::new();
     }
     let grid = Grid::build(&rule);
-    collect_bonds(&rule, &grid)
+    collect_bonds(&rule, &grid, &AtomicU64::new(0))
 }
 
 /// [`build_bonds`] with limits, for untrusted input: refuses (before any large allocation)
@@ -405,6 +407,16 @@ pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
 /// candidate pairs exceeds [`max_candidate_pairs`] ([`BondError::TooMany`]); the output is
 /// reserved with `try_reserve` ([`BondError::Alloc`]). Same bonds as [`build_bonds`] otherwise.
 pub fn try_build_bonds(m: &Molecule, opts: &BondOptions) -> Result<Vec<[u32; 2]>, BondError> {
+    try_build_bonds_with_progress(m, opts, &AtomicU64::new(0))
+}
+
+/// [`try_build_bonds`] adding to `done` the atoms whose neighbours have been searched (up to
+/// the atom count), for a progress display that reads it from another thread.
+pub fn try_build_bonds_with_progress(
+    m: &Molecule,
+    opts: &BondOptions,
+    done: &AtomicU64,
+) -> Result<Vec<[u32; 2]>, BondError> {
     let n = m.len();
     if n < 2 {
         return Ok(Vec::new());
@@ -434,7 +446,7 @@ pub fn try_build_bonds(m: &Molecule, opts: &BondOptions) -> Result<Vec<[u32; 2]>
             bytes: estimate.min(16 * n as u64) * 8,
         })?;
     drop(probe);
-    Ok(collect_bonds(&rule, &grid))
+    Ok(collect_bonds(&rule, &grid, done))
 }
 
 /// Largest grid extent, in units of the largest cutoff, that [`try_build_bonds`] accepts
@@ -526,8 +538,9 @@ fn check_extent(m: &Molecule, cut: f32) -> Result<(), BondError> {
     Ok(())
 }
 
-/// Bonds from a built grid (the parallel neighbour search of [`build_bonds`]).
-fn collect_bonds(rule: &Rule<'_>, grid: &Grid) -> Vec<[u32; 2]> {
+/// Bonds from a built grid (the parallel neighbour search of [`build_bonds`]), adding each
+/// searched chunk's atoms to `done`.
+fn collect_bonds(rule: &Rule<'_>, grid: &Grid, done: &AtomicU64) -> Vec<[u32; 2]> {
     let n = rule.m.len();
     const CHUNK: usize = 4096;
     let chunks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(CHUNK))
@@ -558,6 +571,8 @@ fn collect_bonds(rule: &Rule<'_>, grid: &Grid) -> Vec<[u32; 2]> {
                 js.sort_unstable();
                 out.extend(js.iter().map(|&j| [i as u32, j]));
             }
+            let atoms = ((c + 1) * CHUNK).min(n) - c * CHUNK;
+            done.fetch_add(atoms as u64, Ordering::Relaxed);
             out
         })
         .collect();

@@ -2,15 +2,16 @@
 //! with its BVH, the density volume with macrocells and classified transfer function, and the
 //! light volume (paper §4.1 steps 3-5), with per-stage timings and a memory check first.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use molecule::bonds::{try_build_bonds, BondOptions};
+use molecule::bonds::{try_build_bonds_with_progress, BondOptions};
 use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
-    build_density, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells, MarchOptions,
-    TransferFunction, Volume, VolumeScene,
+    build_density_with_progress, density_work, ClassifiedTf, DensityParams, Grid, LightVolume,
+    Macrocells, MarchOptions, TransferFunction, Volume, VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -34,6 +35,39 @@ pub enum Stage {
     Macrocells,
     /// Light volume.
     LightVolume,
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stage::Bonds => "bonds",
+            Stage::Model => "BVH",
+            Stage::Volume => "density volume",
+            Stage::Macrocells => "macrocells",
+            Stage::LightVolume => "light volume",
+        })
+    }
+}
+
+/// Where [`Scene::build_with`] reports progress: `stage` is called as each stage starts, with
+/// the units of work the stage counts (atoms searched for bonds, primitives placed in the BVH,
+/// slab passes of the density, z-planes of the light volume, 1 for macrocells); the stage adds
+/// the units it finishes to `done`, which is set to 0 after `stage` returns (so `stage` still
+/// reads the last stage's count) and before the work starts, so another thread can draw a
+/// bar from the two.
+pub struct Progress<'a> {
+    /// Called as each stage starts with its total units.
+    pub stage: &'a dyn Fn(Stage, u64),
+    /// Units finished in the running stage.
+    pub done: &'a AtomicU64,
+}
+
+impl Progress<'_> {
+    /// Announces `stage` of `total` units and resets `done`.
+    fn start(&self, stage: Stage, total: u64) {
+        (self.stage)(stage, total);
+        self.done.store(0, Ordering::Relaxed);
+    }
 }
 
 /// Wall time of each stage (seconds; 0 for stages not run).
@@ -93,15 +127,20 @@ pub struct Scene {
 impl Scene {
     /// Builds the scene of `m` with backend `isa` (density and light volume kernels).
     pub fn build(isa: Isa, m: &Molecule, settings: &SceneSettings) -> Result<Scene, SceneError> {
-        Scene::build_with(isa, m, settings, &|_| {})
+        let done = AtomicU64::new(0);
+        let progress = Progress {
+            stage: &|_, _| {},
+            done: &done,
+        };
+        Scene::build_with(isa, m, settings, &progress)
     }
 
-    /// [`Scene::build`] calling `progress` as each stage starts.
+    /// [`Scene::build`] reporting each stage and its work done to `progress`.
     pub fn build_with(
         isa: Isa,
         m: &Molecule,
         settings: &SceneSettings,
-        progress: &dyn Fn(Stage),
+        progress: &Progress,
     ) -> Result<Scene, SceneError> {
         let mut s = Scene {
             settings: settings.clone(),
@@ -126,15 +165,20 @@ impl Scene {
     /// Vec (refilled in place for file bonds) and the per-atom radius and colour scratch; the
     /// BVH, volume and light volume are built anew (their builders allocate).
     pub fn rebuild(&mut self, isa: Isa, m: &Molecule) -> Result<(), SceneError> {
-        self.rebuild_with(isa, m, &|_| {})
+        let done = AtomicU64::new(0);
+        let progress = Progress {
+            stage: &|_, _| {},
+            done: &done,
+        };
+        self.rebuild_with(isa, m, &progress)
     }
 
-    /// [`Scene::rebuild`] calling `progress` as each stage starts.
+    /// [`Scene::rebuild`] reporting each stage and its work done to `progress`.
     pub fn rebuild_with(
         &mut self,
         isa: Isa,
         m: &Molecule,
-        progress: &dyn Fn(Stage),
+        progress: &Progress,
     ) -> Result<(), SceneError> {
         if m.is_empty() {
             return Err(SceneError::NoAtoms);
@@ -149,7 +193,7 @@ impl Scene {
             check_model(ms)?;
         }
         if st.model.is_some() || st.bonds.unwrap {
-            progress(Stage::Bonds);
+            progress.start(Stage::Bonds, m.len() as u64);
         }
         let t = Instant::now();
         let keep_crossing = st.model.as_ref().is_some_and(|ms| ms.periodic_bonds);
@@ -159,6 +203,7 @@ impl Scene {
             keep_crossing,
             m,
             &mut self.bonds,
+            progress.done,
         )?;
         self.timings.bonds = t.elapsed().as_secs_f64();
         // From here on the frame is the unwrapped one (model, volume, camera sphere).
@@ -187,9 +232,10 @@ impl Scene {
             }
         }
         if let Some(ms) = &st.model {
-            progress(Stage::Model);
+            let prims = model_prim_count(m.len(), self.bonds.len(), ms).1;
+            progress.start(Stage::Model, prims as u64);
             let t = Instant::now();
-            let model = build_model(m, &self.bonds, ms, &mut self.scratch)?;
+            let model = build_model(m, &self.bonds, ms, &mut self.scratch, progress.done)?;
             if ms.wide_bvh {
                 model.wide();
             }
@@ -197,11 +243,22 @@ impl Scene {
             self.timings.model = t.elapsed().as_secs_f64();
         }
         if let Some(vs) = &st.volume {
-            progress(Stage::Volume);
+            let units = self
+                .estimate
+                .volume_dims
+                .map_or(0, |d| density_work(d, vs.format));
+            progress.start(Stage::Volume, units);
             let t = Instant::now();
-            let volume = build_volume(isa, m, vs, st.budget_bytes, &mut self.scratch.0)?;
+            let volume = build_volume(
+                isa,
+                m,
+                vs,
+                st.budget_bytes,
+                &mut self.scratch.0,
+                progress.done,
+            )?;
             self.timings.volume = t.elapsed().as_secs_f64();
-            progress(Stage::Macrocells);
+            progress.start(Stage::Macrocells, 1);
             let t = Instant::now();
             let cells = Macrocells::build(&volume);
             let tf_max = match vs.density_max {
@@ -217,6 +274,7 @@ impl Scene {
             };
             let tf = ClassifiedTf::new(&vs.tf, 0.0, tf_max, vs.step_voxels);
             self.timings.macrocells = t.elapsed().as_secs_f64();
+            progress.done.store(1, Ordering::Relaxed);
             let d = DensityVolume {
                 volume,
                 cells,
@@ -224,10 +282,19 @@ impl Scene {
                 tf_max,
             };
             if let Some(lv) = &vs.light_volume {
-                progress(Stage::LightVolume);
+                progress.start(
+                    Stage::LightVolume,
+                    LightVolume::planes(&d.volume.grid, lv.stride),
+                );
                 let t = Instant::now();
                 let scene = VolumeScene::new(&d.volume, &d.cells, &d.tf, MarchOptions::default());
-                self.light_volume = Some(LightVolume::build(isa, &scene, lv.shadows(), lv.stride));
+                self.light_volume = Some(LightVolume::build_with_progress(
+                    isa,
+                    &scene,
+                    lv.shadows(),
+                    lv.stride,
+                    progress.done,
+                ));
                 self.timings.light_volume = t.elapsed().as_secs_f64();
             }
             self.volume = Some(d);
@@ -302,7 +369,7 @@ impl BondSettings {
     /// that still cross the cell after unwrapping ([`ModelSettings::periodic_bonds`]).
     pub fn prepare(&self, m: &Molecule, keep_crossing: bool) -> Result<Prepared, SceneError> {
         let mut bonds = Vec::new();
-        let u = prepare_into(self, true, keep_crossing, m, &mut bonds)?;
+        let u = prepare_into(self, true, keep_crossing, m, &mut bonds, &AtomicU64::new(0))?;
         let (unwrapped, unwrap) = match u {
             Some((m, r)) => (Some(m), Some(r)),
             None => (None, None),
@@ -366,10 +433,11 @@ fn prepare_into(
     keep_crossing: bool,
     m: &Molecule,
     out: &mut Vec<[u32; 2]>,
+    done: &AtomicU64,
 ) -> Result<Option<(Molecule, UnwrapReport)>, SceneError> {
     if !b.unwrap {
         if draw {
-            fill_bonds(b, m, out)?;
+            fill_bonds(b, m, out, done)?;
         } else {
             out.clear();
         }
@@ -391,7 +459,7 @@ fn prepare_into(
             },
             unwrap: false,
         };
-        fill_bonds(&pbc, m, out)?;
+        fill_bonds(&pbc, m, out, done)?;
     }
     let mut u = m.clone();
     unwrap(&mut u, out)?;
@@ -414,10 +482,15 @@ fn prepare_into(
     Ok(Some((u, report)))
 }
 
-/// Replaces `out` with the bonds of `m`.
-fn fill_bonds(b: &BondSettings, m: &Molecule, out: &mut Vec<[u32; 2]>) -> Result<(), SceneError> {
+/// Replaces `out` with the bonds of `m` (adding the atoms searched to `done`).
+fn fill_bonds(
+    b: &BondSettings,
+    m: &Molecule,
+    out: &mut Vec<[u32; 2]>,
+    done: &AtomicU64,
+) -> Result<(), SceneError> {
     match b.source {
-        BondSource::Auto => *out = try_build_bonds(m, &b.options)?,
+        BondSource::Auto => *out = try_build_bonds_with_progress(m, &b.options, done)?,
         BondSource::File => {
             let fb = m.file_bonds.as_ref().ok_or(SceneError::NoFileBonds)?;
             out.clear();
@@ -446,6 +519,7 @@ pub(crate) fn build_model(
     bonds: &[[u32; 2]],
     ms: &ModelSettings,
     scratch: &mut (Vec<f32>, Vec<u32>),
+    done: &AtomicU64,
 ) -> Result<Model, SceneError> {
     check_model(ms)?;
     let (radius, colors) = scratch;
@@ -497,13 +571,21 @@ pub(crate) fn build_model(
     if ms.draw_cell && m.cell.is_none() {
         return Err(SceneError::NoCell);
     }
-    Ok(Model::new(&m.x, &m.y, &m.z, radius, colors, bonds, &opt))
+    Ok(Model::new_with_progress(
+        &m.x, &m.y, &m.z, radius, colors, bonds, &opt, done,
+    ))
 }
 
 impl ModelSettings {
     /// The ball-and-stick model of `m` with `bonds` (what [`Scene::build`] builds).
     pub fn build_model(&self, m: &Molecule, bonds: &[[u32; 2]]) -> Result<Model, SceneError> {
-        build_model(m, bonds, self, &mut (Vec::new(), Vec::new()))
+        build_model(
+            m,
+            bonds,
+            self,
+            &mut (Vec::new(), Vec::new()),
+            &AtomicU64::new(0),
+        )
     }
 }
 
@@ -537,6 +619,7 @@ fn build_volume(
     vs: &VolumeSettings,
     budget_bytes: Option<u64>,
     radii: &mut Vec<f32>,
+    done: &AtomicU64,
 ) -> Result<Volume, SceneError> {
     density_radii(m, radii);
     let params = DensityParams {
@@ -544,7 +627,9 @@ fn build_volume(
         format: vs.format,
         budget_bytes,
     };
-    Ok(build_density(isa, &m.x, &m.y, &m.z, radii, &params)?)
+    Ok(build_density_with_progress(
+        isa, &m.x, &m.y, &m.z, radii, &params, done,
+    )?)
 }
 
 impl VolumeSettings {
@@ -555,7 +640,7 @@ impl VolumeSettings {
         isa: Isa,
         m: &Molecule,
     ) -> Result<(Volume, Macrocells), SceneError> {
-        let v = build_volume(isa, m, self, None, &mut Vec::new())?;
+        let v = build_volume(isa, m, self, None, &mut Vec::new(), &AtomicU64::new(0))?;
         let c = Macrocells::build(&v);
         Ok((v, c))
     }

@@ -19,7 +19,7 @@ mod periodic;
 mod report;
 mod settings;
 
-pub use build::{DensityVolume, Prepared, Scene, Stage, Timings, UnwrapReport};
+pub use build::{DensityVolume, Prepared, Progress, Scene, Stage, Timings, UnwrapReport};
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};

@@ -1,8 +1,9 @@
 //! Model assembly: styles, radii, colours, BVH.
 
+use std::sync::atomic::AtomicU64;
 use std::sync::OnceLock;
 
-use bvh::{Bvh, Geometry, Prim, WideBvh};
+use bvh::{BuildOptions, Bvh, Geometry, Prim, WideBvh};
 use rayon::prelude::*;
 
 use molecule::Cell;
@@ -113,6 +114,22 @@ impl Model {
         bonds: &[[u32; 2]],
         opt: &ModelOptions,
     ) -> Model {
+        Model::new_with_progress(x, y, z, radius, colors, bonds, opt, &AtomicU64::new(0))
+    }
+
+    /// [`Model::new`] adding the primitives the BVH builder has placed to `done` (see
+    /// [`Model::from_geometry_with_progress`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new_with_progress(
+        x: &[f32],
+        y: &[f32],
+        z: &[f32],
+        radius: &[f32],
+        colors: &[u32],
+        bonds: &[[u32; 2]],
+        opt: &ModelOptions,
+        done: &AtomicU64,
+    ) -> Model {
         let n = x.len();
         let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
         let mut color_range = None;
@@ -164,7 +181,7 @@ impl Model {
                 add_cell_edges(&mut g, cell, CELL_COLOR);
             }
         }
-        let mut m = Model::from_geometry(g);
+        let mut m = Model::from_geometry_with_progress(g, done);
         m.color_range = color_range;
         m
     }
@@ -172,7 +189,13 @@ impl Model {
     /// Builds the BVH and colour tables for ready-made geometry (colours from
     /// `g.balls.color`, grey where missing).
     pub fn from_geometry(g: Geometry) -> Model {
-        let bvh = Bvh::build(&g);
+        Model::from_geometry_with_progress(g, &AtomicU64::new(0))
+    }
+
+    /// [`Model::from_geometry`] adding to `done` the primitives the BVH builder has placed
+    /// in finished subtrees (up to `g.prim_count()`), for a progress display.
+    pub fn from_geometry_with_progress(g: Geometry, done: &AtomicU64) -> Model {
+        let bvh = Bvh::build_with_progress(&g, &BuildOptions::default(), done);
         let color = |end: u32| -> i32 {
             g.endpoint_color(end)
                 .unwrap_or(crate::rgba(200, 200, 200, 255)) as i32

@@ -8,6 +8,8 @@
 //! and the interpolant between lattice points is trilinear. "Voxel" as a length unit means one
 //! `spacing` (= 1 / voxels-per-Å).
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd};
 
@@ -154,7 +156,7 @@ impl Grid {
 }
 
 /// Voxel storage.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum VolumeData {
     /// Exact f32 values.
     F32(Vec<f32>),
@@ -320,6 +322,31 @@ pub fn build_density(
     r: &[f32],
     params: &DensityParams,
 ) -> Result<Volume, VolumeError> {
+    build_density_with_progress(isa, x, y, z, r, params, &AtomicU64::new(0))
+}
+
+/// Units of work [`build_density_with_progress`] counts for a lattice of `dims` points in
+/// `format`: one per slab of 4 lattice planes and pass (u8 makes two passes: maximum, then
+/// quantise).
+pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
+    let passes = match format {
+        VolumeFormat::F32 => 1,
+        VolumeFormat::U8 => 2,
+    };
+    dims[2].div_ceil(SLAB) as u64 * passes
+}
+
+/// [`build_density`] adding each finished slab pass to `done` (up to [`density_work`]), for
+/// a progress display that reads it from another thread.
+pub fn build_density_with_progress(
+    isa: Isa,
+    x: &[f32],
+    y: &[f32],
+    z: &[f32],
+    r: &[f32],
+    params: &DensityParams,
+    done: &AtomicU64,
+) -> Result<Volume, VolumeError> {
     let grid = Grid::for_atoms(x, y, z, r, params.voxels_per_angstrom)?;
     let needed = estimate_bytes(&grid, params.format);
     let budget = params.budget_bytes.or_else(default_budget_bytes);
@@ -376,6 +403,7 @@ pub fn build_density(
                         out[o..o + block.len()].copy_from_slice(block);
                         m = fmax(m, block);
                     });
+                    done.fetch_add(1, Ordering::Relaxed);
                     m
                 })
                 .reduce(|| 0.0, f32::max);
@@ -393,6 +421,7 @@ pub fn build_density(
                 .map_init(Vec::new, |buf: &mut Vec<f32>, slab| {
                     let mut m = 0.0f32;
                     ctx.splat(slab, buf, |_, _, block| m = fmax(m, block));
+                    done.fetch_add(1, Ordering::Relaxed);
                     m
                 })
                 .reduce(|| 0.0, f32::max);
@@ -417,6 +446,7 @@ pub fn build_density(
                             out: &mut out[o..o + block.len()],
                         });
                     });
+                    done.fetch_add(1, Ordering::Relaxed);
                 });
             Ok(Volume {
                 grid,

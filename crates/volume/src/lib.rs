@@ -66,8 +66,8 @@ mod tau;
 pub mod tf;
 
 pub use grid::{
-    build_density, default_budget_bytes, estimate_bytes, DensityParams, Grid, Volume, VolumeData,
-    VolumeFormat,
+    build_density, build_density_with_progress, default_budget_bytes, density_work, estimate_bytes,
+    DensityParams, Grid, Volume, VolumeData, VolumeFormat,
 };
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{classify_values, march, march_rays, Rays};

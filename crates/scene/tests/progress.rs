@@ -1,0 +1,119 @@
+//! Scene::build_with's progress: every stage that starts is announced with its units of work,
+//! and its counter ends exactly there (so a bar reaches 100 % and never passes it), for both
+//! volume formats and with unwrapping; the scene is the same as without progress.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+use molecule::scenes::{generate, SceneName};
+use molecule::Cell;
+use scene::{
+    BondSettings, LightVolumeSettings, ModelSettings, Progress, Scene, SceneSettings, Stage,
+    VolumeSettings,
+};
+use spmd::Isa;
+use volume::{Light, VolumeFormat};
+
+/// Builds `st` over `m` and returns each stage with its announced units and the units it
+/// counted (read as the next stage is announced, before the count is reset, or at the end).
+fn stages(m: &molecule::Molecule, st: &SceneSettings) -> (Scene, Vec<(Stage, u64, u64)>) {
+    let done = AtomicU64::new(0);
+    let seen: Mutex<Vec<(Stage, u64, u64)>> = Mutex::new(Vec::new());
+    let stage = |s: Stage, units: u64| {
+        let mut v = seen.lock().unwrap();
+        if let Some(last) = v.last_mut() {
+            last.2 = done.load(Ordering::Relaxed);
+        }
+        v.push((s, units, 0));
+    };
+    let progress = Progress {
+        stage: &stage,
+        done: &done,
+    };
+    let scene = Scene::build_with(Isa::Scalar, m, st, &progress).unwrap();
+    let mut v = seen.into_inner().unwrap();
+    if let Some(last) = v.last_mut() {
+        last.2 = done.load(Ordering::Relaxed);
+    }
+    (scene, v)
+}
+
+fn settings(format: VolumeFormat, unwrap: bool) -> SceneSettings {
+    SceneSettings {
+        model: Some(ModelSettings::default()),
+        bonds: BondSettings {
+            unwrap,
+            ..BondSettings::default()
+        },
+        volume: Some(VolumeSettings {
+            voxels_per_angstrom: 2.0,
+            format,
+            light_volume: Some(LightVolumeSettings {
+                light: Light::Directional([1.0, 2.0, 1.5]),
+                step_voxels: 2.0,
+                stride: 2,
+            }),
+            ..VolumeSettings::default()
+        }),
+        budget_bytes: Some(u64::MAX),
+        ..SceneSettings::default()
+    }
+}
+
+#[test]
+fn every_stage_counts_up_to_its_announced_units() {
+    let m = generate(SceneName::Nanobowl, Some(3000), 1);
+    for format in [VolumeFormat::U8, VolumeFormat::F32] {
+        let st = settings(format, false);
+        let (scene, v) = stages(&m, &st);
+        let names: Vec<Stage> = v.iter().map(|s| s.0).collect();
+        assert_eq!(
+            names,
+            [
+                Stage::Bonds,
+                Stage::Model,
+                Stage::Volume,
+                Stage::Macrocells,
+                Stage::LightVolume
+            ]
+        );
+        for &(s, units, counted) in &v {
+            assert!(units > 0, "{s}: no units announced");
+            assert_eq!(
+                counted, units,
+                "{s} ({format:?}): counted {counted} of {units}"
+            );
+        }
+        // The announced units are the work itself: atoms, primitives, z-planes.
+        assert_eq!(v[0].1, m.len() as u64);
+        let md = scene.model.as_ref().unwrap();
+        assert_eq!(v[1].1, md.bvh.stats.prims as u64);
+        let lv = scene.light_volume.as_ref().unwrap();
+        assert_eq!(v[4].1, lv.grid.dims[2] as u64);
+        // Reporting changes nothing: the same scene as a plain build.
+        let plain = Scene::build(Isa::Scalar, &m, &st).unwrap();
+        assert_eq!(plain.bonds, scene.bonds);
+        assert_eq!(plain.model.unwrap().bvh.nodes, md.bvh.nodes);
+        let (a, b) = (
+            &plain.volume.unwrap().volume,
+            &scene.volume.as_ref().unwrap().volume,
+        );
+        assert_eq!(a.data, b.data);
+    }
+}
+
+#[test]
+fn unwrapping_counts_the_bond_search_once() {
+    // In a periodic box around the atoms, unwrapping searches bonds with the minimum image.
+    let mut m = generate(SceneName::Ns90k, Some(4000), 1);
+    let (lo, hi) = m.bounds();
+    m.cell = Some(Cell::orthogonal(lo, hi.map(|v| v + 1.0)));
+    let st = SceneSettings {
+        volume: None,
+        ..settings(VolumeFormat::U8, true)
+    };
+    let (_, v) = stages(&m, &st);
+    assert_eq!(v[0], (Stage::Bonds, m.len() as u64, m.len() as u64));
+    assert_eq!(v[1].0, Stage::Model);
+    assert_eq!(v[1].1, v[1].2);
+}

@@ -329,6 +329,17 @@ pub(crate) fn background(args: &LookArgs) -> [u8; 3] {
     })
 }
 
+/// Colour of the legend's text: whichever of black and white stands out from the background.
+pub(crate) fn legend_ink(args: &LookArgs) -> [u8; 3] {
+    let [r, g, b] = background(args);
+    let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
+    if luma > 128.0 {
+        [0, 0, 0]
+    } else {
+        [255, 255, 255]
+    }
+}
+
 /// The light of the flags: `--light-pos`, else `--light-dir`, else the default direction.
 pub(crate) fn light(args: &LookArgs) -> Light {
     match (args.light_pos, args.light_dir) {

@@ -13,7 +13,7 @@ use spmd::Isa;
 
 use crate::input::InputArgs;
 use crate::look::{
-    background, check_modalities, march_options, render_settings, scene_settings, LookArgs,
+    check_modalities, legend_ink, march_options, render_settings, scene_settings, LookArgs,
 };
 
 /// Which frames of a series the camera is fitted to.
@@ -192,15 +192,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
                     hi,
                     colormap: *colormap,
                 };
-                // Text in whichever of black and white stands out from the background.
-                let [r, g, b] = background(&args.look);
-                let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
-                let ink = if luma > 128.0 {
-                    [0, 0, 0]
-                } else {
-                    [255, 255, 255]
-                };
-                if draw_legend(&mut fb, &legend, ink).is_none() {
+                if draw_legend(&mut fb, &legend, legend_ink(&args.look)).is_none() {
                     eprintln!(
                         "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
                         render::MIN_LEGEND_FRAME

@@ -18,7 +18,7 @@ use series::{
 use spmd::Isa;
 
 use crate::input::InputArgs;
-use crate::look::{background, render_settings, scene_settings};
+use crate::look::{legend_ink, render_settings, scene_settings};
 use crate::render_cmd::{FitFrames, RenderArgs};
 
 /// Renders `args.frames` of the input file.
@@ -62,15 +62,7 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
             }
         }
     };
-    let legend_ink = args.look.geometry.legend.then(|| {
-        let [r, g, b] = background(&args.look);
-        let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
-        if luma > 128.0 {
-            [0, 0, 0]
-        } else {
-            [255, 255, 255]
-        }
-    });
+    let legend_ink = args.look.geometry.legend.then(|| legend_ink(&args.look));
     let settings = SeriesSettings {
         frames,
         scene,

@@ -18,7 +18,7 @@ pub use peak::{retained_bytes, Peak, PeakPhase, BASELINE_BYTES};
 /// nanobowl and 0.654 on ns90k.
 pub const BVH_NODES_PER_PRIM: f64 = 0.70;
 /// 8-wide BVH nodes per primitive, with `bvh::wide`'s SAH collapse (nodes nearly full:
-/// 6.6-6.7 children on average): measured 0.064 (nanobowl), 0.059 (ns90k), 0.057 (ns740k),
+/// 6.3-6.7 children on average): measured 0.064 (nanobowl), 0.059 (ns90k), 0.057 (ns740k),
 /// 0.068 (sio2 at 200 K atoms), 0.063 (sio2), 0.060 (anp3), so within ±10 %. (The greedy
 /// collapse before it: 0.097, 0.122, 0.124, 0.085, 0.148, its half-empty bottom nodes
 /// depending on the depth of the binary tree.)

@@ -4,8 +4,15 @@
 //! diffuse or blurred-metal hits share few nodes. Here one ray visits only its own nodes and
 //! tests a node's eight child boxes in one SIMD op (two on SSE4.1, eight on scalar), as
 //! Embree's BVH8 single-ray kernels. The tree is the binary BVH collapsed: each wide node
-//! takes a binary inner node and repeatedly opens its largest-area inner child until it has
-//! eight children; leaves (and their primitive records) are the binary BVH's own.
+//! takes a binary inner node and a cut of its subtree of at most eight nodes as children,
+//! the cuts chosen by a dynamic program for the least SAH cost ([`plan`]); leaves (and their
+//! primitive records) are the binary BVH's own.
+//!
+//! (Before: greedy, open the largest-area inner child until eight. Nodes per primitive
+//! varied 0.085-0.148 with the scene, half-empty nodes at the bottom; see BENCHMARKS.md,
+//! "Wide BVH: SAH collapse".)
+
+mod plan;
 
 use spmd::{Scalar, Simd, V3};
 
@@ -13,6 +20,7 @@ use crate::geometry::{Aabb, Geometry};
 use crate::intersect::intersect_record;
 use crate::traverse::{slab_test, PacketHit, Ray, RayPacket, BOX_GROW};
 use crate::tree::Bvh;
+use plan::{children, count_wide, plan};
 
 /// Children per wide node.
 pub const WIDTH: usize = 8;
@@ -72,51 +80,34 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Collapses `bvh` into 8-wide nodes (O(binary nodes)).
+    /// Collapses `bvh` into 8-wide nodes with the fewest node visits by the SAH ([`plan`]),
+    /// O(binary nodes); allocates the exact node count.
     pub fn new(bvh: &Bvh) -> WideBvh {
         let mut w = WideBvh {
-            nodes: Vec::with_capacity(bvh.nodes.len() / 4 + 1),
+            nodes: Vec::new(),
             depth: 0,
             records: bvh.records.len(),
         };
         if bvh.nodes.is_empty() || bvh.records.is_empty() {
             return w;
         }
-        w.collapse(bvh, 0, 0);
+        let plan = plan(bvh);
+        w.nodes.reserve_exact(count_wide(bvh, &plan));
+        w.collapse(bvh, &plan, 0, 0);
         w
     }
 
     /// Makes the wide node for binary node `b` (its children: `b` itself when `b` is a leaf,
-    /// so a one-leaf tree still has a root) and returns its index.
-    fn collapse(&mut self, bvh: &Bvh, b: usize, depth: usize) -> u32 {
+    /// so a one-leaf tree still has a root; else the cut `plan` chose) and returns its index.
+    fn collapse(&mut self, bvh: &Bvh, plan: &[u32], b: usize, depth: usize) -> u32 {
         self.depth = self.depth.max(depth);
         let at = self.nodes.len();
         self.nodes.push(WideNode::EMPTY);
-        let mut kids: Vec<usize> = if bvh.nodes[b].is_leaf() {
-            vec![b]
-        } else {
-            let c = bvh.nodes[b].first as usize;
-            vec![c, c + 1]
-        };
-        while kids.len() < WIDTH {
-            let open = kids
-                .iter()
-                .enumerate()
-                .filter(|(_, &k)| !bvh.nodes[k].is_leaf())
-                .max_by(|a, b| {
-                    let (aa, ab) = (bvh.nodes[*a.1].aabb().area(), bvh.nodes[*b.1].aabb().area());
-                    aa.total_cmp(&ab)
-                })
-                .map(|(i, _)| i);
-            let Some(i) = open else { break };
-            let c = bvh.nodes[kids[i]].first as usize;
-            kids[i] = c;
-            kids.push(c + 1);
-        }
+        let (kids, n) = children(bvh, plan, b);
         let mut node = WideNode::EMPTY;
-        node.n = kids.len() as u32;
-        for (i, &k) in kids.iter().enumerate() {
-            let bn = bvh.nodes[k];
+        node.n = n as u32;
+        for (i, &k) in kids[..n].iter().enumerate() {
+            let bn = bvh.nodes[k as usize];
             for a in 0..3 {
                 node.min[a][i] = bn.min[a];
                 node.max[a][i] = bn.max[a];
@@ -125,7 +116,7 @@ impl WideBvh {
                 node.child[i] = bn.first;
                 node.count[i] = bn.count() as u8;
             } else {
-                node.child[i] = self.collapse(bvh, k, depth + 1);
+                node.child[i] = self.collapse(bvh, plan, k as usize, depth + 1);
             }
         }
         self.nodes[at] = node;

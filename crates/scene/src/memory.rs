@@ -17,10 +17,12 @@ pub use peak::{retained_bytes, Peak, PeakPhase, BASELINE_BYTES};
 /// Binary BVH nodes per primitive (binned SAH builder, leaves of ≤ 4): measured 0.696 on
 /// nanobowl and 0.654 on ns90k.
 pub const BVH_NODES_PER_PRIM: f64 = 0.70;
-/// 8-wide BVH nodes per primitive: measured 0.085 (sio2, 200K atoms), 0.097 (nanobowl) and
-/// 0.122 (ns90k), so one constant is within ±25 % of the wide BVH (a fifth of the model's
-/// bytes); the total is held within 10 % by `crates/scene/tests/build.rs`.
-pub const WIDE_NODES_PER_PRIM: f64 = 0.10;
+/// 8-wide BVH nodes per primitive, with `bvh::wide`'s SAH collapse (nodes nearly full:
+/// 6.3-6.7 children on average): measured 0.064 (nanobowl), 0.059 (ns90k), 0.057 (ns740k),
+/// 0.068 (sio2 at 200 K atoms), 0.063 (sio2), 0.060 (anp3), so within ±10 %. (The greedy
+/// collapse before it: 0.097, 0.122, 0.124, 0.085, 0.148, its half-empty bottom nodes
+/// depending on the depth of the binary tree.)
+pub const WIDE_NODES_PER_PRIM: f64 = 0.062;
 /// Bytes per pixel of the frame `render` draws: the packed RGBA8 framebuffer (the tile
 /// driver keeps its sums per tile; the f32 `render::Accum` of progressive front ends, 12 B
 /// more per pixel, is not counted). Measured: `render 2r9r-1b.xyz` (1,284 atoms) peaks 12.6 MB

@@ -30,6 +30,9 @@ const MODEL_TEMP_BYTES_PER_ATOM: u64 = 8;
 /// Bytes per atom of the bond search's cell grid: cell key, atom list and cell of each atom
 /// (3 × u32) plus the cell starts (u32, at most 2 cells per atom).
 const BOND_GRID_BYTES_PER_ATOM: u64 = 20;
+/// Bytes per binary BVH node of the wide collapse's plan (`bvh::wide`'s cut of each binary
+/// node, a u32), alive while the wide nodes are written.
+const WIDE_PLAN_BYTES_PER_NODE: u64 = 4;
 /// Bytes of a ball's geometry (x, y, z, radius, colour).
 const BALL_BYTES: u64 = 20;
 /// Bytes of a stick's geometry (two atom indices) and of a bond in the bond list.
@@ -48,7 +51,7 @@ pub enum PeakPhase {
     /// BVH build, while the records are written: molecule, bonds, scratch, the model's
     /// temporaries, geometry, primitive references, nodes, ids and records.
     Bvh,
-    /// 8-wide BVH build: the model at rest plus the wide nodes.
+    /// 8-wide BVH build: the model at rest plus the wide nodes and the collapse's plan.
     WideBvh,
     /// Density build: the model at rest (if any), the per-slab atom lists, the per-thread
     /// block scratch and the voxels.
@@ -126,7 +129,12 @@ impl Peak {
                 + e.bvh;
             phases.push((PeakPhase::Bvh, bvh));
             if e.wide_bvh > 0 {
-                let wide = e.atoms + bond_list + e.scratch + model_rest + e.wide_bvh;
+                let wide = e.atoms
+                    + bond_list
+                    + e.scratch
+                    + model_rest
+                    + e.wide_bvh
+                    + c.nodes * WIDE_PLAN_BYTES_PER_NODE;
                 phases.push((PeakPhase::WideBvh, wide));
             }
         }

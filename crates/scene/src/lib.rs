@@ -11,6 +11,7 @@ mod build;
 mod camera;
 mod camera_spec;
 mod colormap;
+mod describe;
 mod error;
 mod fit;
 mod memory;
@@ -23,6 +24,7 @@ pub use build::{DensityVolume, Prepared, Progress, Scene, Stage, Timings, Unwrap
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
+pub use describe::{Description, EstimateFor, LoadedFrame};
 pub use error::SceneError;
 pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD};
 pub use memory::{

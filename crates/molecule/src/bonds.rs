@@ -546,33 +546,9 @@ fn collect_bonds(rule: &Rule<'_>, grid: &Grid, done: &AtomicU64) -> Vec<[u32; 2]
     let chunks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
-            let mut out = Vec::new();
-            let mut js: Vec<u32> = Vec::new();
-            let (mut nx, mut ny, mut nz) = ([0usize; 3], [0usize; 3], [0usize; 3]);
-            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                let cc = cell_coords(grid.cell_of[i], grid.dims);
-                let cx = grid.axis_neighbours(cc[0], 0, &mut nx);
-                let cy = grid.axis_neighbours(cc[1], 1, &mut ny);
-                let cz = grid.axis_neighbours(cc[2], 2, &mut nz);
-                js.clear();
-                for &z in &nz[..cz] {
-                    for &y in &ny[..cy] {
-                        for &x in &nx[..cx] {
-                            let cell = x + grid.dims[0] * (y + grid.dims[1] * z);
-                            let (s, e) = (grid.start[cell] as usize, grid.start[cell + 1] as usize);
-                            for &j in &grid.atoms[s..e] {
-                                if (j as usize) > i && rule.bonded(i, j as usize) {
-                                    js.push(j);
-                                }
-                            }
-                        }
-                    }
-                }
-                js.sort_unstable();
-                out.extend(js.iter().map(|&j| [i as u32, j]));
-            }
-            let atoms = ((c + 1) * CHUNK).min(n) - c * CHUNK;
-            done.fetch_add(atoms as u64, Ordering::Relaxed);
+            let atoms = c * CHUNK..((c + 1) * CHUNK).min(n);
+            let out = chunk_bonds(rule, grid, atoms.clone());
+            done.fetch_add(atoms.len() as u64, Ordering::Relaxed);
             out
         })
         .collect();
@@ -580,6 +556,37 @@ fn collect_bonds(rule: &Rule<'_>, grid: &Grid, done: &AtomicU64) -> Vec<[u32; 2]
     let mut out = Vec::with_capacity(total);
     for c in chunks {
         out.extend_from_slice(&c);
+    }
+    out
+}
+
+/// The bonds `[i, j]` with `i` in `atoms` and `j > i`, sorted: each atom's neighbour cells
+/// searched in the grid.
+fn chunk_bonds(rule: &Rule<'_>, grid: &Grid, atoms: std::ops::Range<usize>) -> Vec<[u32; 2]> {
+    let mut out = Vec::new();
+    let mut js: Vec<u32> = Vec::new();
+    let (mut nx, mut ny, mut nz) = ([0usize; 3], [0usize; 3], [0usize; 3]);
+    for i in atoms {
+        let cc = cell_coords(grid.cell_of[i], grid.dims);
+        let cx = grid.axis_neighbours(cc[0], 0, &mut nx);
+        let cy = grid.axis_neighbours(cc[1], 1, &mut ny);
+        let cz = grid.axis_neighbours(cc[2], 2, &mut nz);
+        js.clear();
+        for &z in &nz[..cz] {
+            for &y in &ny[..cy] {
+                for &x in &nx[..cx] {
+                    let cell = x + grid.dims[0] * (y + grid.dims[1] * z);
+                    let (s, e) = (grid.start[cell] as usize, grid.start[cell + 1] as usize);
+                    for &j in &grid.atoms[s..e] {
+                        if (j as usize) > i && rule.bonded(i, j as usize) {
+                            js.push(j);
+                        }
+                    }
+                }
+            }
+        }
+        js.sort_unstable();
+        out.extend(js.iter().map(|&j| [i as u32, j]));
     }
     out
 }

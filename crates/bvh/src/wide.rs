@@ -5,7 +5,7 @@
 //! tests a node's eight child boxes in one SIMD op (two on SSE4.1, eight on scalar), as
 //! Embree's BVH8 single-ray kernels. The tree is the binary BVH collapsed: each wide node
 //! takes a binary inner node and a cut of its subtree of at most eight nodes as children,
-//! the cuts chosen by a dynamic program for the least SAH cost ([`plan`]); leaves (and their
+//! the cuts chosen by a dynamic program for the least SAH cost (`wide/plan.rs`); leaves (and their
 //! primitive records) are the binary BVH's own.
 //!
 //! (Before: greedy, open the largest-area inner child until eight. Nodes per primitive
@@ -80,7 +80,7 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Collapses `bvh` into 8-wide nodes with the fewest node visits by the SAH ([`plan`]),
+    /// Collapses `bvh` into 8-wide nodes with the fewest node visits by the SAH (`wide/plan.rs`),
     /// O(binary nodes); allocates the exact node count.
     pub fn new(bvh: &Bvh) -> WideBvh {
         let mut w = WideBvh {

@@ -163,27 +163,19 @@ fn wide_tree_of_tiny_and_one_leaf_scenes() {
 /// degenerate scene (every atom at one point, zero-area boxes: 65 nodes, 58 if all full).
 #[test]
 fn wide_nodes_are_well_filled() {
-    for (n, seed) in [(20_000usize, 31u64), (3_000, 32)] {
-        let g = random_molecule(n, true, seed);
-        let bvh = Bvh::build(&g);
+    let check_filled = |g: &Geometry, label: &str| {
+        let bvh = Bvh::build(g);
         let wide = WideBvh::new(&bvh);
-        wide.validate(&bvh, &g).unwrap();
+        wide.validate(&bvh, g).unwrap();
         let per_leaf = wide.nodes.len() as f64 / bvh.stats.leaves as f64;
-        assert!(
-            per_leaf < 0.2,
-            "{n} atoms: {per_leaf:.3} wide nodes per leaf"
-        );
+        assert!(per_leaf < 0.2, "{label}: {per_leaf:.3} wide nodes per leaf");
+    };
+    for (n, seed) in [(20_000usize, 31u64), (3_000, 32)] {
+        check_filled(&random_molecule(n, true, seed), &format!("{n} atoms"));
     }
     let (x, y, z) = ([1.0f32; 500], [2.0f32; 500], [3.0f32; 500]);
-    let g = Geometry::from_atoms(&x, &y, &z, &[0.0; 500], &[0; 500], &[], 0.15);
-    let bvh = Bvh::build(&g);
-    let wide = WideBvh::new(&bvh);
-    wide.validate(&bvh, &g).unwrap();
-    let per_leaf = wide.nodes.len() as f64 / bvh.stats.leaves as f64;
-    assert!(
-        per_leaf < 0.2,
-        "one point: {per_leaf:.3} wide nodes per leaf"
-    );
+    let one_point = Geometry::from_atoms(&x, &y, &z, &[0.0; 500], &[0; 500], &[], 0.15);
+    check_filled(&one_point, "one point");
 }
 
 #[test]

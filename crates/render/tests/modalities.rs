@@ -49,7 +49,7 @@ fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Model {
         show_balls: true,
         capped: false,
     };
-    Model::from_geometry(g)
+    Model::from_geometry(g, None)
 }
 
 /// A 21×21 slab of overlapping unit balls in the plane y = 0 (spacing 1 Å, so its top is a
@@ -383,6 +383,7 @@ fn molecule_scene() -> Model {
         &g.balls.color,
         &pairs,
         &render::ModelOptions::default(),
+        None,
     )
 }
 

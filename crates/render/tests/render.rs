@@ -42,6 +42,7 @@ fn every_backend_matches_scalar() {
             &g.balls.color,
             &pairs(&g),
             &opt,
+            None,
         );
         scene.bvh.validate(&scene.geometry).unwrap();
         for view in [View::Far, View::Close] {
@@ -105,7 +106,7 @@ fn sphere_and_cylinder() -> Model {
         show_balls: true,
         capped: false,
     };
-    Model::from_geometry(g)
+    Model::from_geometry(g, None)
 }
 
 #[test]
@@ -229,6 +230,7 @@ fn scalar_colormap_and_png() {
         &[],
         &pairs(&g),
         &opt,
+        None,
     );
     assert_eq!(scene.geometry.balls.color[0], rgba(68, 1, 84, 255));
     assert_eq!(scene.geometry.balls.color[499], rgba(253, 231, 37, 255));

@@ -103,6 +103,7 @@ fn protein_renders_alike_on_every_backend() {
             &atoms.color,
             &bonds,
             &opt,
+            None,
         );
         scene.bvh.validate(&scene.geometry).unwrap();
         for view in [View::Far, View::Close] {

@@ -10,8 +10,8 @@ use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
-    build_density_with_progress, density_work, ClassifiedTf, DensityParams, Grid, LightVolume,
-    Macrocells, MarchOptions, TransferFunction, Volume, VolumeScene,
+    build_density, density_work, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells,
+    MarchOptions, TransferFunction, Volume, VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -571,8 +571,15 @@ pub(crate) fn build_model(
     if ms.draw_cell && m.cell.is_none() {
         return Err(SceneError::NoCell);
     }
-    Ok(Model::new_with_progress(
-        &m.x, &m.y, &m.z, radius, colors, bonds, &opt, done,
+    Ok(Model::new(
+        &m.x,
+        &m.y,
+        &m.z,
+        radius,
+        colors,
+        bonds,
+        &opt,
+        Some(done),
     ))
 }
 
@@ -627,8 +634,14 @@ fn build_volume(
         format: vs.format,
         budget_bytes,
     };
-    Ok(build_density_with_progress(
-        isa, &m.x, &m.y, &m.z, radii, &params, done,
+    Ok(build_density(
+        isa,
+        &m.x,
+        &m.y,
+        &m.z,
+        radii,
+        &params,
+        Some(done),
     )?)
 }
 

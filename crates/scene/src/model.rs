@@ -103,6 +103,8 @@ impl Model {
     /// Builds a scene from atom positions (Å), per-atom base radius (Å, scaled by
     /// `opt.radius_scale`), per-atom colours (packed RGBA8, see [`crate::rgba`]) and bonds.
     /// Bonds with an atom index out of range are ignored. `colors` may be empty (grey).
+    /// `done`, if given, counts the primitives the BVH builder has placed (see
+    /// [`Model::from_geometry`]), for a progress display.
     /// Panics if `x`, `y`, `z` and `radius` differ in length.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -113,22 +115,7 @@ impl Model {
         colors: &[u32],
         bonds: &[[u32; 2]],
         opt: &ModelOptions,
-    ) -> Model {
-        Model::new_with_progress(x, y, z, radius, colors, bonds, opt, &AtomicU64::new(0))
-    }
-
-    /// [`Model::new`] adding the primitives the BVH builder has placed to `done` (see
-    /// [`Model::from_geometry_with_progress`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new_with_progress(
-        x: &[f32],
-        y: &[f32],
-        z: &[f32],
-        radius: &[f32],
-        colors: &[u32],
-        bonds: &[[u32; 2]],
-        opt: &ModelOptions,
-        done: &AtomicU64,
+        done: Option<&AtomicU64>,
     ) -> Model {
         let n = x.len();
         let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
@@ -181,20 +168,18 @@ impl Model {
                 add_cell_edges(&mut g, cell, CELL_COLOR);
             }
         }
-        let mut m = Model::from_geometry_with_progress(g, done);
+        let mut m = Model::from_geometry(g, done);
         m.color_range = color_range;
         m
     }
 
     /// Builds the BVH and colour tables for ready-made geometry (colours from
-    /// `g.balls.color`, grey where missing).
-    pub fn from_geometry(g: Geometry) -> Model {
-        Model::from_geometry_with_progress(g, &AtomicU64::new(0))
-    }
-
-    /// [`Model::from_geometry`] adding to `done` the primitives the BVH builder has placed
-    /// in finished subtrees (up to `g.prim_count()`), for a progress display.
-    pub fn from_geometry_with_progress(g: Geometry, done: &AtomicU64) -> Model {
+    /// `g.balls.color`, grey where missing). `done`, if given, counts the primitives the BVH
+    /// builder has placed in finished subtrees (up to `g.prim_count()`), for a progress
+    /// display that reads it from another thread.
+    pub fn from_geometry(g: Geometry, done: Option<&AtomicU64>) -> Model {
+        let unwatched = AtomicU64::new(0);
+        let done = done.unwrap_or(&unwatched);
         let bvh = Bvh::build_with_progress(&g, &BuildOptions::default(), done);
         let color = |end: u32| -> i32 {
             g.endpoint_color(end)

@@ -3,11 +3,13 @@
 
 use molecule::scenes::{generate, SceneName};
 use scene::{
-    BondSettings, BondSource, ColorBy, LightVolumeSettings, MemoryEstimate, ModelSettings, Scene,
-    SceneError, SceneSettings, Style, VolumeSettings,
+    BondSettings, BondSource, ColorBy, MemoryEstimate, ModelSettings, Scene, SceneError,
+    SceneSettings, Style,
 };
 use spmd::Isa;
-use volume::Light;
+use volume::VolumeFormat;
+
+mod common;
 
 fn settings(wide: bool, volume: bool) -> SceneSettings {
     SceneSettings {
@@ -15,15 +17,7 @@ fn settings(wide: bool, volume: bool) -> SceneSettings {
             wide_bvh: wide,
             ..ModelSettings::default()
         }),
-        volume: volume.then(|| VolumeSettings {
-            voxels_per_angstrom: 2.0,
-            light_volume: Some(LightVolumeSettings {
-                light: Light::Directional([1.0, 2.0, 1.5]),
-                step_voxels: 2.0,
-                stride: 2,
-            }),
-            ..VolumeSettings::default()
-        }),
+        volume: volume.then(|| common::lit_volume(VolumeFormat::U8)),
         budget_bytes: Some(u64::MAX),
         frame: Some((64, 48)),
         ..SceneSettings::default()

@@ -5,14 +5,13 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
+mod common;
+
 use molecule::scenes::{generate, SceneName};
 use molecule::Cell;
-use scene::{
-    BondSettings, LightVolumeSettings, ModelSettings, Progress, Scene, SceneSettings, Stage,
-    VolumeSettings,
-};
+use scene::{BondSettings, ModelSettings, Progress, Scene, SceneSettings, Stage};
 use spmd::Isa;
-use volume::{Light, VolumeFormat};
+use volume::VolumeFormat;
 
 /// Builds `st` over `m` and returns each stage with its announced units and the units it
 /// counted (read as the next stage is announced, before the count is reset, or at the end).
@@ -45,16 +44,7 @@ fn settings(format: VolumeFormat, unwrap: bool) -> SceneSettings {
             unwrap,
             ..BondSettings::default()
         },
-        volume: Some(VolumeSettings {
-            voxels_per_angstrom: 2.0,
-            format,
-            light_volume: Some(LightVolumeSettings {
-                light: Light::Directional([1.0, 2.0, 1.5]),
-                step_voxels: 2.0,
-                stride: 2,
-            }),
-            ..VolumeSettings::default()
-        }),
+        volume: Some(common::lit_volume(format)),
         budget_bytes: Some(u64::MAX),
         ..SceneSettings::default()
     }

@@ -16,7 +16,7 @@ fn scene() -> (synthetic::Atoms, Volume, Macrocells, ClassifiedTf) {
         format: VolumeFormat::U8,
         budget_bytes: None,
     };
-    let v = build_density(Isa::detect(), &a.x, &a.y, &a.z, &a.r, &p).unwrap();
+    let v = build_density(Isa::detect(), &a.x, &a.y, &a.z, &a.r, &p, None).unwrap();
     let mc = Macrocells::build(&v);
     let tf = ClassifiedTf::new(
         &TransferFunction::preset(Preset::CoolWarm),
@@ -77,7 +77,7 @@ fn benches(c: &mut Criterion) {
     };
     for isa in Isa::supported() {
         g.bench_function(BenchmarkId::from_parameter(isa), |b| {
-            b.iter(|| build_density(isa, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap())
+            b.iter(|| build_density(isa, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p, None).unwrap())
         });
     }
     g.finish();

@@ -57,7 +57,7 @@ fn main() {
     let mut vol = None;
     for &isa in &isas {
         let (t, c) = (Instant::now(), cpu_secs());
-        let v = build_density(isa, &a.x, &a.y, &a.z, &a.r, &p).unwrap();
+        let v = build_density(isa, &a.x, &a.y, &a.z, &a.r, &p, None).unwrap();
         let (dt, dc) = (t.elapsed().as_secs_f64(), cpu_secs() - c);
         println!(
             "density_build {isa:>7}: {dt:.2} s wall, {dc:.2} s CPU  grid {:?} = {:.0} MB u8 (scale {:.3e}, max {:.3})",

@@ -300,6 +300,17 @@ pub fn default_budget_bytes() -> Option<u64> {
     Some(kb * 1024 / 4 * 3)
 }
 
+/// Units of work [`build_density`] counts for a lattice of `dims` points in
+/// `format`: one per slab of 4 lattice planes and pass (u8 makes two passes: maximum, then
+/// quantise).
+pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
+    let passes = match format {
+        VolumeFormat::F32 => 1,
+        VolumeFormat::U8 => 2,
+    };
+    dims[2].div_ceil(SLAB) as u64 * passes
+}
+
 /// Builds the density volume of the atoms (positions `x, y, z` and covalent radii `r`, Å)
 /// on [`Grid::for_atoms`] at `params.voxels_per_angstrom`, using backend `isa`.
 ///
@@ -314,6 +325,9 @@ pub fn default_budget_bytes() -> Option<u64> {
 /// Errors: inconsistent or non-finite input, or [`VolumeError::TooLarge`] (with a suggested
 /// resolution) when [`estimate_bytes`] exceeds the budget or the voxel count exceeds what
 /// 32-bit gather indices can address.
+///
+/// `done`, if given, gains one per finished slab pass (up to [`density_work`]), for a
+/// progress display that reads it from another thread.
 pub fn build_density(
     isa: Isa,
     x: &[f32],
@@ -321,32 +335,10 @@ pub fn build_density(
     z: &[f32],
     r: &[f32],
     params: &DensityParams,
+    done: Option<&AtomicU64>,
 ) -> Result<Volume, VolumeError> {
-    build_density_with_progress(isa, x, y, z, r, params, &AtomicU64::new(0))
-}
-
-/// Units of work [`build_density_with_progress`] counts for a lattice of `dims` points in
-/// `format`: one per slab of 4 lattice planes and pass (u8 makes two passes: maximum, then
-/// quantise).
-pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
-    let passes = match format {
-        VolumeFormat::F32 => 1,
-        VolumeFormat::U8 => 2,
-    };
-    dims[2].div_ceil(SLAB) as u64 * passes
-}
-
-/// [`build_density`] adding each finished slab pass to `done` (up to [`density_work`]), for
-/// a progress display that reads it from another thread.
-pub fn build_density_with_progress(
-    isa: Isa,
-    x: &[f32],
-    y: &[f32],
-    z: &[f32],
-    r: &[f32],
-    params: &DensityParams,
-    done: &AtomicU64,
-) -> Result<Volume, VolumeError> {
+    let unwatched = AtomicU64::new(0);
+    let done = done.unwrap_or(&unwatched);
     let grid = Grid::for_atoms(x, y, z, r, params.voxels_per_angstrom)?;
     let needed = estimate_bytes(&grid, params.format);
     let budget = params.budget_bytes.or_else(default_budget_bytes);

@@ -33,7 +33,7 @@
 //! // Once per data set (atoms as SoA slices, Å; r = covalent radius).
 //! let (x, y, z, r) = (vec![0.0f32, 1.4], vec![0.0f32, 0.0], vec![0.0f32, 0.0], vec![0.76f32; 2]);
 //! let params = DensityParams { voxels_per_angstrom: 4.0, format: VolumeFormat::U8, budget_bytes: None };
-//! let vol = build_density(isa, &x, &y, &z, &r, &params)?;
+//! let vol = build_density(isa, &x, &y, &z, &r, &params, None)?;
 //! let cells = Macrocells::build(&vol);
 //! // Whenever the transfer function (or its value range) changes.
 //! let tf = ClassifiedTf::new(&TransferFunction::preset(Preset::CoolWarm), 0.0, vol.max_value, 0.5);
@@ -66,8 +66,8 @@ mod tau;
 pub mod tf;
 
 pub use grid::{
-    build_density, build_density_with_progress, default_budget_bytes, density_work, estimate_bytes,
-    DensityParams, Grid, Volume, VolumeData, VolumeFormat,
+    build_density, default_budget_bytes, density_work, estimate_bytes, DensityParams, Grid, Volume,
+    VolumeData, VolumeFormat,
 };
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{classify_values, march, march_rays, Rays};

@@ -16,7 +16,7 @@ fn params(vpa: f32, format: VolumeFormat) -> DensityParams {
 }
 
 fn build(isa: Isa, a: &Atoms, p: &DensityParams) -> Volume {
-    build_density(isa, &a.x, &a.y, &a.z, &a.r, p).unwrap()
+    build_density(isa, &a.x, &a.y, &a.z, &a.r, p, None).unwrap()
 }
 
 /// Tolerance of the f32 grid against the f64 sum: 2e-6 absolute + 1e-5 relative (f32 exp is
@@ -170,7 +170,7 @@ fn refuses_over_budget_with_a_resolution_that_fits() {
     let need = estimate_bytes(&grid, VolumeFormat::F32);
     assert!(need >= grid.voxel_count() * 4);
     p.budget_bytes = Some(need / 10);
-    let err = build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p).unwrap_err();
+    let err = build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p, None).unwrap_err();
     let msg = err.to_string();
     let VolumeError::TooLarge {
         suggested_voxels_per_angstrom: s,
@@ -187,14 +187,15 @@ fn refuses_over_budget_with_a_resolution_that_fits() {
     let g2 = Grid::for_atoms(&a.x, &a.y, &a.z, &a.r, s).unwrap();
     assert!(estimate_bytes(&g2, VolumeFormat::F32) <= need / 10);
     p.voxels_per_angstrom = s;
-    assert!(build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p).is_ok());
+    assert!(build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p, None).is_ok());
 }
 
 #[test]
 fn rejects_bad_input() {
     let p = params(4.0, VolumeFormat::F32);
-    let e =
-        |x: &[f32], r: &[f32]| build_density(Isa::Scalar, x, &[0.0], &[0.0], r, &p).unwrap_err();
+    let e = |x: &[f32], r: &[f32]| {
+        build_density(Isa::Scalar, x, &[0.0], &[0.0], r, &p, None).unwrap_err()
+    };
     assert!(matches!(
         e(&[0.0, 1.0], &[1.0]),
         VolumeError::LengthMismatch { .. }
@@ -208,7 +209,7 @@ fn rejects_bad_input() {
         VolumeError::BadRadius { atom: 0, .. }
     ));
     assert!(matches!(
-        build_density(Isa::Scalar, &[], &[], &[], &[], &p),
+        build_density(Isa::Scalar, &[], &[], &[], &[], &p, None),
         Err(VolumeError::NoAtoms)
     ));
     let bad = DensityParams {
@@ -216,7 +217,7 @@ fn rejects_bad_input() {
         ..p
     };
     assert!(matches!(
-        build_density(Isa::Scalar, &[0.0], &[0.0], &[0.0], &[1.0], &bad),
+        build_density(Isa::Scalar, &[0.0], &[0.0], &[0.0], &[1.0], &bad, None),
         Err(VolumeError::BadResolution(_))
     ));
     assert_eq!("u8".parse::<VolumeFormat>().unwrap(), VolumeFormat::U8);

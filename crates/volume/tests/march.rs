@@ -205,7 +205,16 @@ fn volume_of(atoms: &Atoms, vpa: f32, format: VolumeFormat) -> (Volume, Macrocel
         format,
         budget_bytes: None,
     };
-    let v = build_density(Isa::Scalar, &atoms.x, &atoms.y, &atoms.z, &atoms.r, &p).unwrap();
+    let v = build_density(
+        Isa::Scalar,
+        &atoms.x,
+        &atoms.y,
+        &atoms.z,
+        &atoms.r,
+        &p,
+        None,
+    )
+    .unwrap();
     let mc = Macrocells::build(&v);
     (v, mc)
 }

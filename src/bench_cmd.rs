@@ -153,7 +153,6 @@ pub fn run(a: BenchArgs, isas: Vec<Isa>) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::look::Mode;
     use bnsbench::{plan, BenchMode};
 
     fn args(extra: &[&str]) -> BenchArgs {
@@ -234,14 +233,12 @@ mod tests {
         for m in BenchMode::ALL {
             let argv = std::iter::once("render").chain(render_flags(m).iter().copied());
             let a = R::parse_from(argv).r;
-            crate::look::check_modalities(&a).unwrap();
-            assert_eq!(crate::look::render_settings(&a), m.settings(), "{m:?}");
-            assert_eq!(a.mode != Mode::Volume, m.geometry(), "{m:?}");
-            assert_eq!(
-                matches!(a.mode, Mode::Volume | Mode::VolBs),
-                m.volume(),
-                "{m:?}"
-            );
+            let (look, bench) = (a.look(false).unwrap(), m.look());
+            look.validate().unwrap();
+            assert_eq!(look.render_settings(), bench.render_settings(), "{m:?}");
+            // What is built (the transfer function's table is long: no Debug dump).
+            let built = |l: &render::Look| l.scene_settings(Default::default(), (64, 64));
+            assert!(built(&look) == built(&bench), "{m:?}");
         }
     }
 

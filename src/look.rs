@@ -1,44 +1,14 @@
 //! The flags of what a frame shows and how it is lit — size, mode, camera, style, volume,
 //! lighting, path tracing, performance — shared by `render` and `view`, and their mapping onto
-//! the typed [`SceneSettings`] and [`RenderSettings`] of the libraries.
+//! the typed [`render::Look`] (whose methods give the scene and render settings).
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, ValueEnum};
-use render::{
-    Camera, Material, Modality, RenderSettings, SecondaryTraversal, DARK_BACKGROUND,
-    HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
-};
-use scene::{LightVolumeSettings, Orbit, SceneSettings, Sphere, ViewPreset, LIGHT_VOLUME_STRIDE};
-use volume::{Light, Lighting, MarchOptions, TransferFunction, VolumeShadows};
+use clap::Args;
+use render::{Camera, Look, Material, Mode, SecondaryTraversal};
+use scene::{Orbit, Sphere, ViewPreset};
+use volume::{Light, TransferFunction};
 
-use crate::input::InputArgs;
 use crate::pipeline::{GeometryArgs, VolumeArgs};
-
-/// What a frame shows (the rows of the paper's Table 3).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
-    /// Ball-and-stick, headlight diffuse shading.
-    Bs,
-    /// Direct volume rendering of the RBF density alone.
-    Volume,
-    /// Ball-and-stick, then the volume in front of it.
-    #[value(name = "vol+bs")]
-    VolBs,
-    /// Ball-and-stick, path traced (`--material`, `--spp`): progressive f32 accumulation.
-    Path,
-}
-
-impl Mode {
-    /// Name as on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Mode::Bs => "bs",
-            Mode::Volume => "volume",
-            Mode::VolBs => "vol+bs",
-            Mode::Path => "path",
-        }
-    }
-}
 
 /// Three finite numbers `x,y,z`.
 fn vec3(s: &str) -> Option<[f32; 3]> {
@@ -214,19 +184,47 @@ impl LookArgs {
         Ok(())
     }
 
-    /// The transfer function of `--tf` with `--opacity` applied, for the modes that draw the
-    /// volume (`None` for bs and path).
-    pub fn transfer_function(&self) -> Result<Option<TransferFunction>> {
-        Ok(match self.mode {
-            Mode::Bs | Mode::Path => None,
-            Mode::Volume | Mode::VolBs => {
-                let tf = TransferFunction::from_spec(&self.tf)?;
-                Some(if self.opacity == 1.0 {
-                    tf
-                } else {
-                    tf.scale_opacity(self.opacity)
-                })
-            }
+    /// The typed look of the flags; `pbc` (an input flag) draws bonds across the cell as
+    /// half-sticks. Parses `--tf` whatever the mode, so the viewer can switch to a volume
+    /// mode.
+    pub fn look(&self, pbc: bool) -> Result<Look> {
+        let tf = TransferFunction::from_spec(&self.tf)?;
+        let light = match (self.light_pos, self.light_dir) {
+            (Some(p), _) => Some(Light::Point(p)),
+            (None, d) => d.map(Light::Directional),
+        };
+        Ok(Look {
+            mode: self.mode,
+            model: scene::ModelSettings {
+                periodic_bonds: pbc,
+                ..self.geometry.settings()?
+            },
+            volume: scene::VolumeSettings {
+                tf,
+                ..self.volume.settings()?
+            },
+            opacity: self.opacity,
+            background: self.background,
+            lit: self.lit,
+            shadows: self.shadows,
+            ao: self.ao,
+            ao_distance: self.ao_distance,
+            light,
+            light_intensity: self.light_intensity,
+            ambient: self.ambient,
+            volume_shadows: self.volume_shadows,
+            shadow_step: self.shadow_step,
+            shadow_rays: self.shadow_rays,
+            material: self.material,
+            spp: self.spp,
+            max_depth: self.max_depth,
+            roughness: self.roughness,
+            exposure: self.exposure,
+            sample_seed: self.sample_seed,
+            secondary: self.secondary,
+            bounces: self.bounce_traversal,
+            macrocells: !self.no_macrocells,
+            preintegrated: !self.no_preintegration,
         })
     }
 
@@ -276,156 +274,4 @@ fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
         [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b]),
         _ => Err(format!("{s:?}: expected r,g,b with each 0-255")),
     }
-}
-
-/// What `render` builds for the flags: the model unless `--mode volume`, the volume with
-/// `tf` (given for the volume modes) and its light volume for volumetric shadows unless
-/// `--shadow-rays`, the wide BVH when secondary or bounced rays use it.
-pub(crate) fn scene_settings(
-    args: &LookArgs,
-    input: &InputArgs,
-    tf: Option<TransferFunction>,
-) -> Result<SceneSettings> {
-    let model = if args.mode == Mode::Volume {
-        None
-    } else {
-        let mut ms = args.geometry.settings()?;
-        ms.periodic_bonds = input.pbc;
-        ms.wide_bvh = modality(args) != Modality::Headlight
-            && (args.secondary == SecondaryTraversal::Wide
-                || (args.mode == Mode::Path && args.bounce_traversal == SecondaryTraversal::Wide));
-        Some(ms)
-    };
-    let volume = match tf {
-        Some(tf) => {
-            let shadows = march_options(args).shadows.filter(|_| !args.shadow_rays);
-            Some(scene::VolumeSettings {
-                tf,
-                light_volume: shadows.map(|sh| LightVolumeSettings {
-                    light: sh.light,
-                    step_voxels: sh.step_voxels,
-                    stride: LIGHT_VOLUME_STRIDE,
-                }),
-                ..args.volume.settings()?
-            })
-        }
-        None => None,
-    };
-    Ok(SceneSettings {
-        model,
-        bonds: input.bond_settings()?,
-        volume,
-        budget_bytes: None,
-        frame: Some(args.size),
-    })
-}
-
-/// Background colour: `--background`, else white for `bs` and near-black for the others.
-pub(crate) fn background(args: &LookArgs) -> [u8; 3] {
-    args.background.unwrap_or(if args.mode == Mode::Bs {
-        WHITE_BACKGROUND
-    } else {
-        DARK_BACKGROUND
-    })
-}
-
-/// Colour of the legend's text: whichever of black and white stands out from the background.
-pub(crate) fn legend_ink(args: &LookArgs) -> [u8; 3] {
-    let [r, g, b] = background(args);
-    let luma = 0.299 * r as f32 + 0.587 * g as f32 + 0.114 * b as f32;
-    if luma > 128.0 {
-        [0, 0, 0]
-    } else {
-        [255, 255, 255]
-    }
-}
-
-/// The light of the flags: `--light-pos`, else `--light-dir`, else the default direction.
-pub(crate) fn light(args: &LookArgs) -> Light {
-    match (args.light_pos, args.light_dir) {
-        (Some(p), _) => Light::Point(p),
-        (None, Some(d)) => Light::Directional(d),
-        (None, None) => RenderSettings::default().light,
-    }
-}
-
-/// The volume marcher's options from the flags: lighting (headlight unless a light is given
-/// or shadows need one), volumetric shadows, macrocells and pre-integration.
-pub(crate) fn march_options(args: &LookArgs) -> MarchOptions {
-    let explicit = args.light_pos.is_some() || args.light_dir.is_some() || args.volume_shadows;
-    let lighting = match (args.lit, explicit, light(args)) {
-        (false, _, _) => Lighting::Unlit,
-        (true, false, _) => Lighting::Headlight,
-        (true, true, Light::Directional(d)) => Lighting::Directional(d),
-        (true, true, Light::Point(p)) => Lighting::Point(p),
-    };
-    MarchOptions {
-        macrocells: !args.no_macrocells,
-        preintegrated: !args.no_preintegration,
-        lighting,
-        shadows: args.volume_shadows.then(|| VolumeShadows {
-            light: light(args),
-            step_voxels: args.shadow_step,
-        }),
-        ..MarchOptions::default()
-    }
-}
-
-/// Every render option of the flags as one [`RenderSettings`] (headlight modes: ambient
-/// [`render::HEADLIGHT_AMBIENT`]; `--ambient` is the ambient term of the traced modalities).
-pub(crate) fn render_settings(args: &LookArgs) -> RenderSettings {
-    let modality = modality(args);
-    RenderSettings {
-        modality,
-        march: march_options(args),
-        light: light(args),
-        light_intensity: args.light_intensity,
-        ambient: if modality == Modality::Headlight {
-            HEADLIGHT_AMBIENT
-        } else {
-            args.ambient
-        },
-        background: background(args),
-        exposure: args.exposure,
-        seed: args.sample_seed,
-        spp: if args.mode == Mode::Path { args.spp } else { 1 },
-        volume_shadows: args.volume_shadows,
-        shadow_step_voxels: args.shadow_step,
-        secondary: args.secondary,
-        bounces: args.bounce_traversal,
-        packet_registers: 0,
-    }
-}
-
-/// Rejects combinations of modality flags that do nothing, with what to use instead: the
-/// flag conflicts here, every rule on the resulting settings in [`RenderSettings::validate`].
-pub(crate) fn check_modalities(args: &LookArgs) -> Result<()> {
-    if (args.shadows || args.ao.is_some()) && args.mode == Mode::Path {
-        // The path tracer has its own lighting: these flags would be ignored.
-        return Err(render::SettingsError::NeedsModel.into());
-    }
-    let has_model = args.mode != Mode::Volume;
-    let has_volume = matches!(args.mode, Mode::Volume | Mode::VolBs);
-    Ok(render_settings(args).validate(has_model, has_volume)?)
-}
-
-/// The modality the flags ask for (`Headlight`: the plain b&s / volume / vol+bs modes).
-pub(crate) fn modality(args: &LookArgs) -> Modality {
-    if args.mode == Mode::Path {
-        return Modality::Path {
-            material: args.material,
-            max_depth: args.max_depth,
-            roughness: args.roughness,
-        };
-    }
-    if let Some(n) = args.ao {
-        return Modality::Ao {
-            samples: n,
-            distance: args.ao_distance,
-        };
-    }
-    if args.shadows {
-        return Modality::Direct { shadows: true };
-    }
-    Modality::Headlight
 }

@@ -12,9 +12,7 @@ use scene::{ColorBy, Scene};
 use spmd::Isa;
 
 use crate::input::InputArgs;
-use crate::look::{
-    check_modalities, legend_ink, march_options, render_settings, scene_settings, LookArgs,
-};
+use crate::look::LookArgs;
 
 /// Which frames of a series the camera is fitted to.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,13 +82,14 @@ pub struct RenderArgs {
 /// Run `bnsview render`.
 pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     args.look.init_threads()?;
-    check_modalities(&args.look)?;
+    let look = args.look.look(args.input.pbc)?;
+    look.validate()?;
     let mut input = args.input.clone();
     if input.file.is_none() && input.scene.is_none() {
         input.scene = Some(molecule::scenes::SceneName::Nanobowl);
     }
     if args.frames.is_some() || args.follow {
-        return crate::series_cmd::run(&args, &input, isa);
+        return crate::series_cmd::run(&args, &look, &input, isa);
     }
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = match (&input.file, input.scene) {
@@ -120,7 +119,6 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     let (w, h) = args.look.size;
     let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
     drop(probe);
-    let tf = args.look.transfer_function()?;
     let l = input.load_frame(false)?;
     let m = &l.molecule;
     if m.is_empty() {
@@ -142,7 +140,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         l.source,
         m.len()
     ));
-    let settings = scene_settings(&args.look, &input, tf)?;
+    let settings = look.scene_settings(input.bond_settings()?, args.look.size);
     let sc = crate::progress::follow_build(|p| Scene::build_with(isa, m, &settings, p))?;
     sc.stage_report().into_iter().for_each(verbose);
     // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
@@ -150,8 +148,8 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     let camera = args.look.camera(sc.sphere)?;
     verbose(format!("camera:  --camera {camera}"));
     let scene = sc.model.as_ref();
-    let vscene = sc.volume_scene(march_options(&args.look));
-    let settings = render_settings(&args.look);
+    let vscene = sc.volume_scene(look.march_options());
+    let settings = look.render_settings();
     let inputs = FrameInputs {
         model: scene,
         volume: vscene.as_ref(),
@@ -192,7 +190,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
                     hi,
                     colormap: *colormap,
                 };
-                if draw_legend(&mut fb, &legend, legend_ink(&args.look)).is_none() {
+                if draw_legend(&mut fb, &legend, look.legend_ink()).is_none() {
                     eprintln!(
                         "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
                         render::MIN_LEGEND_FRAME

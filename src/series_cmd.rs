@@ -10,7 +10,7 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use molecule::read::Follower;
-use render::Camera;
+use render::{Camera, Look};
 use series::{
     follow_series, render_series, CameraChoice, FollowSettings, FrameRange, OutputKind,
     SeriesSettings, Sink,
@@ -18,11 +18,10 @@ use series::{
 use spmd::Isa;
 
 use crate::input::InputArgs;
-use crate::look::{legend_ink, render_settings, scene_settings};
 use crate::render_cmd::{FitFrames, RenderArgs};
 
 /// Renders `args.frames` of the input file.
-pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
+pub fn run(args: &RenderArgs, look: &Look, input: &InputArgs, isa: Isa) -> Result<()> {
     let frames = args.frames.unwrap_or(FrameRange::ALL);
     let Some(path) = input.file.clone() else {
         bail!("--frames and --follow render the frames of a trajectory file; built-in scenes have one frame");
@@ -39,10 +38,9 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
         PathBuf::from(format!("{stem}_%05d.png"))
     });
     let kind = OutputKind::from_path(&output)?;
-    let tf = args.look.transfer_function()?;
-    let scene = scene_settings(&args.look, input, tf)?;
-    let render = render_settings(&args.look);
     let (w, h) = args.look.size;
+    let scene = look.scene_settings(input.bond_settings()?, (w, h));
+    let render = look.render_settings();
     let camera = match &args.look.camera {
         Some(spec) => CameraChoice::Fixed(spec.parse::<Camera>()?),
         None => {
@@ -62,7 +60,7 @@ pub fn run(args: &RenderArgs, input: &InputArgs, isa: Isa) -> Result<()> {
             }
         }
     };
-    let legend_ink = args.look.geometry.legend.then(|| legend_ink(&args.look));
+    let legend_ink = args.look.geometry.legend.then(|| look.legend_ink());
     let settings = SeriesSettings {
         frames,
         scene,

@@ -6,10 +6,10 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use molecule::read::{open, FrameIndex};
 use spmd::Isa;
-use viewer::{FrameSource, Toggles, ViewConfig, ViewMode};
+use viewer::{FrameSource, Toggles, ViewConfig};
 
 use crate::input::InputArgs;
-use crate::look::{check_modalities, render_settings, scene_settings, LookArgs, Mode};
+use crate::look::LookArgs;
 
 /// Arguments of `bnsview view`.
 #[derive(Args, Debug)]
@@ -38,28 +38,11 @@ pub struct ViewArgs {
     pub look: LookArgs,
 }
 
-fn view_mode(m: Mode) -> ViewMode {
-    match m {
-        Mode::Bs => ViewMode::Bs,
-        Mode::Volume => ViewMode::Volume,
-        Mode::VolBs => ViewMode::VolBs,
-        Mode::Path => ViewMode::Path,
-    }
-}
-
-fn mode(m: ViewMode) -> Mode {
-    match m {
-        ViewMode::Bs => Mode::Bs,
-        ViewMode::Volume => Mode::Volume,
-        ViewMode::VolBs => Mode::VolBs,
-        ViewMode::Path => Mode::Path,
-    }
-}
-
 /// Run `bnsview view`.
 pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
     args.look.init_threads()?;
-    check_modalities(&args.look)?;
+    let look = args.look.look(args.input.pbc)?;
+    look.validate()?;
     if args.look.geometry.legend {
         bail!("--legend is drawn by `bnsview render` only; the viewer's screenshots have none");
     }
@@ -83,24 +66,20 @@ pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
         }
     };
     let toggles = Toggles {
-        mode: view_mode(args.look.mode),
-        shadows: args.look.shadows,
-        ao: args.look.ao,
-        lit: args.look.lit,
-        opacity: args.look.opacity,
+        mode: look.mode,
+        shadows: look.shadows,
+        ao: look.ao,
+        lit: look.lit,
+        opacity: look.opacity,
     };
-    let look = args.look.clone();
-    let inp = input.clone();
-    // The viewer's toggles set on a copy of the flags: every frame is what `render` makes
-    // of the same flags.
+    // The viewer's toggles set on a copy of the look: every frame is what `render` makes of
+    // the same flags.
+    let (bonds, size) = (input.bond_settings()?, args.look.size);
     let configure = move |t: &Toggles| {
-        let mut a = look.clone();
-        (a.mode, a.shadows, a.ao, a.lit, a.opacity) =
-            (mode(t.mode), t.shadows, t.ao, t.lit, t.opacity);
-        check_modalities(&a).map_err(|e| e.to_string())?;
-        let tf = a.transfer_function().map_err(|e| e.to_string())?;
-        let scene = scene_settings(&a, &inp, tf).map_err(|e| e.to_string())?;
-        Ok((scene, render_settings(&a)))
+        let mut l = look.clone();
+        (l.mode, l.shadows, l.ao, l.lit, l.opacity) = (t.mode, t.shadows, t.ao, t.lit, t.opacity);
+        l.validate().map_err(|e| e.to_string())?;
+        Ok((l.scene_settings(bonds.clone(), size), l.render_settings()))
     };
     let look = args.look.clone();
     let cfg = ViewConfig {

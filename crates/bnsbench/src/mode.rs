@@ -3,8 +3,7 @@
 
 use std::str::FromStr;
 
-use render::{Material, Modality, RenderSettings, DARK_BACKGROUND, WHITE_BACKGROUND};
-use volume::{Light, Lighting, MarchOptions};
+use render::{Look, Material, Mode, RenderSettings};
 
 /// What a benchmark frame shows: the rows of the paper's Table 3, lit volume alone, and the
 /// ray tracing modalities of §4.5 / Figure 4 (one sample per pixel per frame).
@@ -110,27 +109,12 @@ impl BenchMode {
 
     /// Whether the frame shows the ball-and-stick geometry (needs the BVH).
     pub fn geometry(self) -> bool {
-        !matches!(
-            self,
-            BenchMode::Volume
-                | BenchMode::VolumeLit
-                | BenchMode::VolumeShadows
-                | BenchMode::VolumeLitShadows
-        )
+        self.look().mode.has_model()
     }
 
     /// Whether the frame shows the density volume (needs the volume).
     pub fn volume(self) -> bool {
-        matches!(
-            self,
-            BenchMode::Volume
-                | BenchMode::VolBs
-                | BenchMode::VolBsLit
-                | BenchMode::VolumeLit
-                | BenchMode::VolBsShadows
-                | BenchMode::VolumeShadows
-                | BenchMode::VolumeLitShadows
-        )
+        self.look().mode.has_volume()
     }
 
     /// Row of the paper's Table 3 (CPU), if this mode is one.
@@ -138,79 +122,32 @@ impl BenchMode {
         BenchMode::PAPER.iter().position(|&m| m == self)
     }
 
-    /// How the frame is shaded: the settings `bnsview render` uses for the same picture
-    /// (default light, AO distance and material; dark background except plain ball-and-stick
-    /// modes), with one sample per pixel (`--ao 1`, `--spp 1`). The volume pass's options are
-    /// `settings().march`.
-    pub fn settings(self) -> RenderSettings {
+    /// What the frame shows: the look of `bnsview render` with the same flags (default
+    /// light, AO distance and material) at one sample per pixel (`--ao 1`, `--spp 1`).
+    pub fn look(self) -> Look {
         use BenchMode::*;
-        let d = RenderSettings::default();
-        let shadows = Some(volume::VolumeShadows {
-            light: d.light,
-            step_voxels: d.shadow_step_voxels,
-        });
-        let march = |lighting, shadows| MarchOptions {
-            lighting,
-            shadows,
-            ..MarchOptions::default()
+        let mode = match self {
+            Bs | BsShadows | BsAo => Mode::Bs,
+            Volume | VolumeLit | VolumeShadows | VolumeLitShadows => Mode::Volume,
+            VolBs | VolBsLit | VolBsShadows => Mode::VolBs,
+            Path => Mode::Path,
         };
-        let direct = Modality::Direct { shadows: true };
-        let dir = match d.light {
-            Light::Directional(v) => Lighting::Directional(v),
-            Light::Point(p) => Lighting::Point(p),
-        };
-        let (modality, march, background) = match self {
-            Bs => (
-                Modality::Headlight,
-                march(Lighting::Unlit, None),
-                WHITE_BACKGROUND,
-            ),
-            Volume | VolBs => (
-                Modality::Headlight,
-                march(Lighting::Unlit, None),
-                DARK_BACKGROUND,
-            ),
-            VolBsLit | VolumeLit => (
-                Modality::Headlight,
-                march(Lighting::Headlight, None),
-                DARK_BACKGROUND,
-            ),
-            VolumeShadows => (
-                Modality::Headlight,
-                march(Lighting::Unlit, shadows),
-                DARK_BACKGROUND,
-            ),
-            VolumeLitShadows => (Modality::Headlight, march(dir, shadows), DARK_BACKGROUND),
-            BsShadows => (direct, march(Lighting::Unlit, None), WHITE_BACKGROUND),
-            BsAo => (
-                Modality::Ao {
-                    samples: 1,
-                    distance: 4.0,
-                },
-                march(Lighting::Unlit, None),
-                WHITE_BACKGROUND,
-            ),
-            Path => (
-                Modality::Path {
-                    material: Material::Metal,
-                    max_depth: 6,
-                    roughness: 0.15,
-                },
-                march(Lighting::Unlit, None),
-                DARK_BACKGROUND,
-            ),
-            VolBsShadows => (direct, march(Lighting::Unlit, shadows), DARK_BACKGROUND),
-        };
-        let base = match modality {
-            Modality::Headlight => RenderSettings::headlight(background),
-            m => RenderSettings::traced(m, background),
-        };
-        RenderSettings {
-            march,
+        Look {
+            mode,
+            lit: matches!(self, VolBsLit | VolumeLit | VolumeLitShadows),
+            shadows: matches!(self, BsShadows | VolBsShadows),
+            ao: (self == BsAo).then_some(1),
+            volume_shadows: matches!(self, VolBsShadows | VolumeShadows | VolumeLitShadows),
+            material: Material::Metal,
             spp: 1,
-            volume_shadows: march.shadows.is_some(),
-            ..base
+            ..Look::default()
         }
+    }
+
+    /// How the frame is shaded ([`BenchMode::look`]'s settings); the volume pass's options
+    /// are `settings().march`.
+    pub fn settings(self) -> RenderSettings {
+        self.look().render_settings()
     }
 
     /// Random samples per pixel of one frame (AO rays, paths), for the stochastic modes.
@@ -312,6 +249,7 @@ pub enum TableSel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use render::Modality;
 
     #[test]
     fn names_read_back_and_are_distinct() {

@@ -15,6 +15,7 @@ mod driver;
 mod framebuffer;
 mod integrator;
 mod legend;
+mod look;
 mod progress;
 mod rng;
 mod settings;
@@ -27,6 +28,7 @@ pub use driver::{
 pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};
 pub use legend::{draw_legend, draw_text, legend_label, Legend, LegendBox, MIN_LEGEND_FRAME};
+pub use look::{Look, Mode};
 pub use progress::{render_frame_with_progress, PROGRESS_BANDS};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,

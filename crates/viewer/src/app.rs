@@ -11,12 +11,13 @@ use scene::{Camera, ColorBy, Scene, SceneSettings, Sphere};
 use spmd::Isa;
 
 use crate::error::ViewError;
-use crate::keys::{help_lines, toggle, Action, Toggles, ViewMode};
+use crate::keys::{help_lines, toggle, Action, Toggles};
 use crate::loader::{Answer, FrameSource, Loader, Request};
 use crate::nav::Navigation;
 use crate::refine::Refiner;
 use crate::script::Command;
 use crate::window::{Input, Window};
+use render::Mode;
 
 /// The render and scene settings of a set of toggles (`Err`: why they cannot be shown).
 pub type Configure = dyn Fn(&Toggles) -> Result<(SceneSettings, RenderSettings), String>;
@@ -171,7 +172,7 @@ impl App {
     /// The scene settings of the toggles in vol+bs mode (model and volume), when valid.
     fn superset(&self, exact: &SceneSettings) -> SceneSettings {
         let both = Toggles {
-            mode: ViewMode::VolBs,
+            mode: Mode::VolBs,
             ..self.toggles
         };
         match (self.cfg.configure)(&both.effective()) {
@@ -656,18 +657,18 @@ impl App {
 /// mode: no volume for bs and path, no model for volume).
 fn with_inputs<R>(
     shown: &Shown,
-    m: ViewMode,
+    m: Mode,
     settings: &RenderSettings,
     camera: &Camera,
     f: impl FnOnce(&FrameInputs) -> R,
 ) -> R {
-    let volume = if matches!(m, ViewMode::Volume | ViewMode::VolBs) {
+    let volume = if matches!(m, Mode::Volume | Mode::VolBs) {
         shown.scene.volume_scene(settings.march)
     } else {
         None
     };
     f(&FrameInputs {
-        model: shown.scene.model.as_ref().filter(|_| m != ViewMode::Volume),
+        model: shown.scene.model.as_ref().filter(|_| m != Mode::Volume),
         volume: volume.as_ref(),
         camera,
     })

@@ -1,38 +1,15 @@
 //! What the keys do: key names (shared by the window and `--script`'s `key NAME`), the
 //! actions they stand for, and the display toggles they change.
 
-/// What a frame shows (the modes of `bnsview render --mode`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ViewMode {
-    /// Ball-and-stick.
-    Bs,
-    /// The density volume alone.
-    Volume,
-    /// The volume in front of the balls and sticks.
-    VolBs,
-    /// Ball-and-stick, path traced (samples accumulate while the view is still).
-    Path,
-}
+use render::Mode;
 
-impl ViewMode {
-    /// The `--mode` name.
-    pub fn name(self) -> &'static str {
-        match self {
-            ViewMode::Bs => "bs",
-            ViewMode::Volume => "volume",
-            ViewMode::VolBs => "vol+bs",
-            ViewMode::Path => "path",
-        }
-    }
-
-    /// The next mode of the `v` key: bs → vol+bs → volume → path → bs.
-    pub fn next(self) -> ViewMode {
-        match self {
-            ViewMode::Bs => ViewMode::VolBs,
-            ViewMode::VolBs => ViewMode::Volume,
-            ViewMode::Volume => ViewMode::Path,
-            ViewMode::Path => ViewMode::Bs,
-        }
+/// The next mode of the `v` key: bs → vol+bs → volume → path → bs.
+pub fn next_mode(m: Mode) -> Mode {
+    match m {
+        Mode::Bs => Mode::VolBs,
+        Mode::VolBs => Mode::Volume,
+        Mode::Volume => Mode::Path,
+        Mode::Path => Mode::Bs,
     }
 }
 
@@ -40,7 +17,7 @@ impl ViewMode {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Toggles {
     /// What is drawn.
-    pub mode: ViewMode,
+    pub mode: Mode,
     /// Direct light with hard shadows on the balls and sticks (`--shadows`).
     pub shadows: bool,
     /// Ambient occlusion with this many rays per hit (`--ao N`), when on.
@@ -57,10 +34,10 @@ impl Toggles {
     /// the user's choices, so switching back to a mode restores them.
     pub fn effective(self) -> Toggles {
         let (model, volume) = match self.mode {
-            ViewMode::Bs => (true, false),
-            ViewMode::Volume => (false, true),
-            ViewMode::VolBs => (true, true),
-            ViewMode::Path => (false, false),
+            Mode::Bs => (true, false),
+            Mode::Volume => (false, true),
+            Mode::VolBs => (true, true),
+            Mode::Path => (false, false),
         };
         Toggles {
             shadows: self.shadows && model,
@@ -96,7 +73,7 @@ impl Toggles {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     /// Show this mode.
-    Mode(ViewMode),
+    Mode(Mode),
     /// The next mode (bs → vol+bs → volume → path).
     NextMode,
     /// Shadows on/off.
@@ -125,14 +102,10 @@ pub enum Action {
 
 /// Every key: its name (as `--script`'s `key NAME` spells it), the action, and what it does.
 pub const KEYS: &[(&str, Action, &str)] = &[
-    ("1", Action::Mode(ViewMode::Bs), "ball-and-stick"),
-    ("2", Action::Mode(ViewMode::Volume), "volume"),
-    (
-        "3",
-        Action::Mode(ViewMode::VolBs),
-        "volume + ball-and-stick",
-    ),
-    ("4", Action::Mode(ViewMode::Path), "path traced"),
+    ("1", Action::Mode(Mode::Bs), "ball-and-stick"),
+    ("2", Action::Mode(Mode::Volume), "volume"),
+    ("3", Action::Mode(Mode::VolBs), "volume + ball-and-stick"),
+    ("4", Action::Mode(Mode::Path), "path traced"),
     ("v", Action::NextMode, "next mode"),
     ("s", Action::Shadows, "shadows on/off"),
     ("a", Action::Ao, "ambient occlusion on/off"),
@@ -181,7 +154,7 @@ pub fn toggle(t: Toggles, a: Action, ao_samples: u32) -> Option<Toggles> {
     Some(match a {
         Action::Mode(mode) => Toggles { mode, ..t },
         Action::NextMode => Toggles {
-            mode: t.mode.next(),
+            mode: next_mode(t.mode),
             ..t
         },
         // Shadows and AO are alternatives, as on the command line.
@@ -223,13 +196,13 @@ mod tests {
 
     #[test]
     fn v_visits_every_mode_and_returns() {
-        let mut m = ViewMode::Bs;
+        let mut m = Mode::Bs;
         let mut seen = vec![m];
         for _ in 0..3 {
-            m = m.next();
+            m = next_mode(m);
             seen.push(m);
         }
-        assert_eq!(m.next(), ViewMode::Bs);
+        assert_eq!(next_mode(m), Mode::Bs);
         seen.sort_by_key(|m| m.name());
         seen.dedup();
         assert_eq!(seen.len(), 4);
@@ -238,7 +211,7 @@ mod tests {
     #[test]
     fn shadows_and_ao_exclude_each_other_and_flags_list_them() {
         let t = Toggles {
-            mode: ViewMode::VolBs,
+            mode: Mode::VolBs,
             shadows: false,
             ao: None,
             lit: false,
@@ -253,14 +226,14 @@ mod tests {
         assert_eq!(o.flags(), "--mode vol+bs --ao 8 --lit --opacity 2");
         assert_eq!(toggle(t, Action::Reset, 8), None);
         // Each mode shows what it can; switching back restores the rest.
-        let v = toggle(o, Action::Mode(ViewMode::Volume), 8).unwrap();
+        let v = toggle(o, Action::Mode(Mode::Volume), 8).unwrap();
         assert_eq!(v.flags(), "--mode volume --lit --opacity 2");
-        let b = toggle(v, Action::Mode(ViewMode::Bs), 8).unwrap();
+        let b = toggle(v, Action::Mode(Mode::Bs), 8).unwrap();
         assert_eq!(b.flags(), "--mode bs --ao 8");
         assert_eq!(
-            toggle(b, Action::Mode(ViewMode::Path), 8).unwrap().flags(),
+            toggle(b, Action::Mode(Mode::Path), 8).unwrap().flags(),
             "--mode path"
         );
-        assert_eq!(toggle(b, Action::Mode(ViewMode::VolBs), 8).unwrap(), o);
+        assert_eq!(toggle(b, Action::Mode(Mode::VolBs), 8).unwrap(), o);
     }
 }

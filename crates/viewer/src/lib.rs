@@ -18,7 +18,7 @@ mod window;
 
 pub use app::{run, Configure, ViewConfig, ViewReport};
 pub use error::ViewError;
-pub use keys::{action, help_lines, toggle, Action, Toggles, ViewMode, KEYS};
+pub use keys::{action, help_lines, next_mode, toggle, Action, Toggles, KEYS};
 pub use loader::{Answer, FrameSource, Loader, Request};
 pub use nav::Navigation;
 pub use refine::{Refiner, Step};

@@ -129,7 +129,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Command>, ViewError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::keys::ViewMode;
+    use render::Mode;
 
     #[test]
     fn every_command_parses() {
@@ -143,7 +143,7 @@ mod tests {
                 Command::Pan(4.0, 2.5),
                 Command::Zoom(1.5),
                 Command::Key(Action::NextMode),
-                Command::Key(Action::Mode(ViewMode::Volume)),
+                Command::Key(Action::Mode(Mode::Volume)),
                 Command::Frame(3),
                 Command::WaitFrames(5),
                 Command::WaitStill,

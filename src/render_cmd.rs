@@ -8,7 +8,7 @@ use clap::Args;
 use render::{
     draw_legend, render_frame, render_frame_with_progress, FrameInputs, Framebuffer, Legend,
 };
-use scene::{ColorBy, Scene};
+use scene::Scene;
 use spmd::Isa;
 
 use crate::input::InputArgs;
@@ -102,19 +102,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         };
         PathBuf::from(format!("{stem}.png"))
     });
-    render::ImageFormat::from_path(&output)?;
-    if output.exists() && !args.force {
-        bail!("{} exists; pass --force to overwrite it", output.display());
-    }
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            bail!(
-                "cannot write {}: directory {} does not exist",
-                output.display(),
-                dir.display()
-            );
-        }
-    }
+    render::ImageFormat::for_output(&output, args.force)?;
     // Check the frame fits before the expensive preprocessing.
     let (w, h) = args.look.size;
     let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
@@ -171,32 +159,19 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         render_frame(&inputs, &settings, &mut fb, isa)?
     };
     pb.finish_and_clear();
-    if let (Some(md), ColorBy::Column { name, colormap, .. }) = (
-        scene,
-        sc.settings
-            .model
-            .as_ref()
-            .map(|ms| &ms.color)
-            .unwrap_or(&ColorBy::Element),
-    ) {
-        if let Some((lo, hi)) = md.color_range {
-            verbose(format!(
-                "color:   {name} over --color-range {lo}:{hi} ({colormap:?})"
-            ));
-            if args.look.geometry.legend {
-                let legend = Legend {
-                    title: name.clone(),
-                    lo,
-                    hi,
-                    colormap: *colormap,
-                };
-                if draw_legend(&mut fb, &legend, look.legend_ink()).is_none() {
-                    eprintln!(
-                        "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
-                        render::MIN_LEGEND_FRAME
-                    );
-                }
-            }
+    let color = sc.settings.model.as_ref().map(|ms| &ms.color);
+    let range = scene.and_then(|m| m.color_range);
+    if let Some(legend) = color.and_then(|c| Legend::of(c, range)) {
+        let Legend { title, lo, hi, .. } = &legend;
+        verbose(format!(
+            "color:   {title} over --color-range {lo}:{hi} ({:?})",
+            legend.colormap
+        ));
+        if args.look.geometry.legend && draw_legend(&mut fb, &legend, look.legend_ink()).is_none() {
+            eprintln!(
+                "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
+                render::MIN_LEGEND_FRAME
+            );
         }
     }
     let (secs, spp) = (stats.time.as_secs_f64(), settings.frame_samples());

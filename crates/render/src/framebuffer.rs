@@ -19,6 +19,17 @@ pub enum RenderError {
     /// The frame is too large for the PNG encoder or for memory.
     #[error("framebuffer {0}x{1} is too large")]
     TooLarge(u32, u32),
+    /// The output exists and overwriting was not asked for.
+    #[error("{0} exists; pass --force to overwrite it")]
+    Exists(String),
+    /// The output's directory does not exist.
+    #[error("cannot write {path}: directory {dir} does not exist")]
+    NoDirectory {
+        /// The output file.
+        path: String,
+        /// Its missing directory.
+        dir: String,
+    },
 }
 
 /// An image file format a frame is written in.
@@ -42,6 +53,24 @@ impl ImageFormat {
             "png" => Ok(ImageFormat::Png),
             "jpg" | "jpeg" => Ok(ImageFormat::Jpeg),
             _ => Err(RenderError::UnknownFormat(path.display().to_string())),
+        }
+    }
+
+    /// [`ImageFormat::from_path`], and `path` can be written: its directory exists, and it
+    /// does not exist unless `force` (checked before rendering, so nothing the user has is
+    /// overwritten unasked and a long render is not lost at the end).
+    pub fn for_output(path: &Path, force: bool) -> Result<ImageFormat, RenderError> {
+        let format = ImageFormat::from_path(path)?;
+        let shown = || path.display().to_string();
+        if path.exists() && !force {
+            return Err(RenderError::Exists(shown()));
+        }
+        match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            Some(dir) if !dir.is_dir() => Err(RenderError::NoDirectory {
+                path: shown(),
+                dir: dir.display().to_string(),
+            }),
+            _ => Ok(format),
         }
     }
 }

@@ -5,6 +5,7 @@
 use font8x8::UnicodeFonts;
 
 use crate::{rgba, Colormap, Framebuffer};
+use scene::ColorBy;
 
 /// What a legend shows: a column name and the value range its colormap spans.
 #[derive(Clone, Debug, PartialEq)]
@@ -17,6 +18,22 @@ pub struct Legend {
     pub hi: f32,
     /// The colormap.
     pub colormap: Colormap,
+}
+
+impl Legend {
+    /// The legend of a model coloured by `color` over `range` (the model's
+    /// `color_range`): `None` when it is coloured by element or has no range.
+    pub fn of(color: &ColorBy, range: Option<(f32, f32)>) -> Option<Legend> {
+        match (color, range) {
+            (ColorBy::Column { name, colormap, .. }, Some((lo, hi))) => Some(Legend {
+                title: name.clone(),
+                lo,
+                hi,
+                colormap: *colormap,
+            }),
+            _ => None,
+        }
+    }
 }
 
 /// Where [`draw_legend`] put the legend, in pixels (x right, y down, inclusive-exclusive).

@@ -249,6 +249,26 @@ fn scalar_colormap_and_png() {
     fb.save_png(&path).unwrap();
     let back = image::open(&path).unwrap().to_rgba8();
     assert_eq!(back.as_raw().as_slice(), &*fb.as_bytes());
+    // An output check before rendering: the written file is kept unless forced, a missing
+    // directory and an unknown extension are named.
+    use render::{ImageFormat, RenderError};
+    let err = |p: &std::path::Path, force| ImageFormat::for_output(p, force).unwrap_err();
+    assert!(matches!(err(&path, false), RenderError::Exists(_)));
+    assert_eq!(
+        ImageFormat::for_output(&path, true).unwrap(),
+        ImageFormat::Png
+    );
+    let jpg = dir.join("new.JPG");
+    assert_eq!(
+        ImageFormat::for_output(&jpg, false).unwrap(),
+        ImageFormat::Jpeg
+    );
+    let lost = dir.join("no-such-dir").join("x.png");
+    assert!(matches!(err(&lost, true), RenderError::NoDirectory { .. }));
+    assert!(matches!(
+        err(&dir.join("x.tif"), true),
+        RenderError::UnknownFormat(_)
+    ));
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -320,21 +320,9 @@ fn run_series(
         density_max,
         ..SeriesReport::default()
     };
-    let legend = match (&settings.model, s.legend_ink, color_range) {
-        (Some(ms), Some(ink), Some((lo, hi))) => match &ms.color {
-            ColorBy::Column { name, colormap, .. } => Some((
-                Legend {
-                    title: name.clone(),
-                    lo,
-                    hi,
-                    colormap: *colormap,
-                },
-                ink,
-            )),
-            ColorBy::Element => None,
-        },
-        _ => None,
-    };
+    let legend = (settings.model.as_ref())
+        .and_then(|ms| Legend::of(&ms.color, color_range))
+        .zip(s.legend_ink);
     let mut render_one = |b: Built, wait_s: f64| -> Result<(), SeriesError> {
         let t = Instant::now();
         let vscene = b.scene.volume_scene(s.render.march);

@@ -5,23 +5,14 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use molecule::scenes::SceneName;
 use spmd::Isa;
 
-use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel};
+use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel, ViewSel};
 
 use crate::look::parse_size;
 use crate::pipeline::GeometryArgs;
-
-/// Which of the paper's views (Table 3).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ViewArg {
-    /// The whole molecule fits in the frame.
-    Far,
-    /// A quarter of the far distance from the centre, the frame filled.
-    Close,
-}
 
 /// Arguments of `bnsview bench`. The ISA comes from the global `--isa` (`all` = every
 /// backend this CPU supports).
@@ -42,7 +33,7 @@ pub struct BenchArgs {
     pub modes: Option<Vec<ModeSel>>,
     /// Views of Table 3 (comma separated; default far,close).
     #[arg(long, value_enum, value_delimiter = ',')]
-    pub views: Option<Vec<ViewArg>>,
+    pub views: Option<Vec<ViewSel>>,
     /// Frame size of Tables 2 and 3, WIDTHxHEIGHT (default 1024x1024 as in the paper, with
     /// --quick 512x512).
     #[arg(long, value_parser = parse_size)]
@@ -117,10 +108,7 @@ impl BenchArgs {
                 table: self.table,
                 scenes: self.scenes.clone(),
                 modes: self.modes.as_deref().map(expand_modes),
-                views: self
-                    .views
-                    .as_ref()
-                    .map(|v| v.iter().map(|v| *v == ViewArg::Far).collect()),
+                views: self.views.clone(),
                 size: self.size,
                 sizes: self.sizes.clone(),
                 threads: self.threads.clone(),
@@ -188,7 +176,7 @@ mod tests {
         let c = args(&["--views", "close", "--threads", "3", "--quick"])
             .config()
             .unwrap();
-        assert_eq!(c.spec.views, Some(vec![false]));
+        assert_eq!(c.spec.views, Some(vec![ViewSel::Close]));
         assert_eq!(c.spec.threads, Some(vec![3]));
         assert!(c.spec.quick);
         assert_eq!(c.frames, None);

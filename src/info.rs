@@ -1,7 +1,7 @@
 //! `bnsview info`: describe a molecule file or a built-in scene.
 
 use clap::Args;
-use scene::{Description, EstimateFor, LoadedFrame};
+use scene::{Description, EstimateFor};
 
 use crate::input::InputArgs;
 
@@ -32,27 +32,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     if args.input.file.is_none() && args.input.scene.is_none() {
         anyhow::bail!("give a molecule FILE or --scene NAME (nanobowl, ns90k, ns740k, sio2, anp3)");
     }
-    let l = args.input.load(true)?;
+    let l = args.input.load(true, true)?;
     let bond_settings = args.input.bond_settings()?;
-    let frame = LoadedFrame {
-        source: &l.source,
-        format: l.format,
-        file_bytes: l.file_bytes,
-        frame: args.input.frame,
-        frames: l.frames,
-        molecule: &l.molecule,
-        bonds: &l.bonds,
-        bond_settings: &bond_settings,
-        unwrap: l.unwrap.as_ref(),
-        load_s: l.load_s,
-        bond_s: l.bond_s,
-        warnings: &l.warnings,
-    };
     let target = EstimateFor {
         size: args.size,
         voxels_per_angstrom: args.voxels_per_angstrom,
     };
-    let d = Description::new(frame, target)?;
+    let d = Description::new(&l, &bond_settings, target)?;
     if args.json {
         emit(&(serde_json::to_string_pretty(&d.json()).unwrap_or_default() + "\n"));
     } else {

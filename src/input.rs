@@ -2,17 +2,14 @@
 //! scene, one frame of it, and its bonds, with a spinner and timings.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
-use anyhow::{bail, Context};
 use clap::Args;
 use molecule::bonds::BondOptions;
-use molecule::read::{open, Format, FrameIndex, ReadOptions};
-use molecule::scenes::{try_generate, SceneName};
-use molecule::Molecule;
-use scene::BondSource;
+use molecule::read::{Format, ReadOptions};
+use molecule::scenes::SceneName;
+use scene::{BondSource, Input, LoadedFrame};
 
-use crate::progress::{bar, follow_bytes, spinner};
+use crate::progress::{follow_stages, spinner};
 
 /// Where the atoms come from and how they are bonded.
 #[derive(Args, Debug, Clone)]
@@ -64,30 +61,6 @@ pub struct InputArgs {
     pub unwrap: bool,
 }
 
-/// A loaded frame with its bonds and what it took.
-pub struct Loaded {
-    /// Human description of the source (path or scene and seed).
-    pub source: String,
-    /// The frame.
-    pub molecule: Molecule,
-    /// Frames in the input (1 for a scene).
-    pub frames: usize,
-    /// Reader warnings (unknown elements, …).
-    pub warnings: Vec<String>,
-    /// Format of the file, if one was read.
-    pub format: Option<Format>,
-    /// File size in bytes, if one was read.
-    pub file_bytes: Option<u64>,
-    /// Bonds, pairs i<j sorted.
-    pub bonds: Vec<[u32; 2]>,
-    /// Time to read or generate the frame (s).
-    pub load_s: f64,
-    /// Time to build the bonds (s), unwrapping included.
-    pub bond_s: f64,
-    /// How the frame was unwrapped (`--unwrap`; `None` without).
-    pub unwrap: Option<scene::UnwrapReport>,
-}
-
 impl InputArgs {
     /// Bond settings from the flags.
     pub fn bond_settings(&self) -> anyhow::Result<scene::BondSettings> {
@@ -124,112 +97,40 @@ impl InputArgs {
         })
     }
 
-    /// Opens `path` as a trajectory with the flags' reader options.
-    pub fn open_trajectory(
-        &self,
-        path: &std::path::Path,
-    ) -> anyhow::Result<molecule::read::Trajectory> {
-        Ok(open(path, &self.read_options()?)?)
-    }
-
-    /// Reads (or generates) the frame and builds its bonds; `count_frames` also scans the
-    /// whole file for the number of frames.
-    pub fn load(&self, count_frames: bool) -> anyhow::Result<Loaded> {
-        let bonds = self.bond_settings()?;
-        let mut l = self.load_frame(count_frames)?;
-        let pb = spinner(&format!("building bonds for {} atoms", l.molecule.len()));
-        let t1 = Instant::now();
-        // The bonds and (with --unwrap) the unwrapped frame, as `render` builds them.
-        let p = bonds.prepare(&l.molecule, self.pbc)?;
-        l.bonds = p.bonds;
-        if let Some(u) = p.unwrapped {
-            l.molecule = u;
-        }
-        l.unwrap = p.unwrap;
-        l.bond_s = t1.elapsed().as_secs_f64();
-        pb.finish_and_clear();
-        Ok(l)
-    }
-
-    /// Reads (or generates) the frame without bonds (`bonds` empty, `bond_s` 0: the scene
-    /// builds them); `count_frames` as in [`InputArgs::load`].
-    pub fn load_frame(&self, count_frames: bool) -> anyhow::Result<Loaded> {
-        self.bond_settings()?;
-        let t0 = Instant::now();
-        let pb = spinner("loading");
-        let (source, m, frames, warnings, format, file_bytes) = if let Some(scene) = self.scene {
-            if self.frame != 0 {
-                bail!(
-                    "--frame {}: built-in scenes have a single frame",
-                    self.frame
-                );
-            }
-            pb.set_message(format!("generating {scene}"));
-            let m = try_generate(scene, self.atoms, self.seed)?;
-            (
-                format!("scene {scene} (seed {})", self.seed),
-                m,
-                1,
-                Vec::new(),
-                None,
-                None,
-            )
-        } else {
-            let path = self
-                .file
-                .clone()
-                .context("no input: give a FILE or --scene NAME")?;
-            let opts = self.read_options()?;
-            let bytes = std::fs::metadata(&path).map(|m| m.len()).ok();
-            let mut t = open(&path, &opts)?;
-            // A bar over the file's bytes when they are what is read, else a count of them.
-            pb.finish_and_clear();
-            let what = format!("reading {}", path.display());
-            let pb = match bytes.filter(|_| !t.is_gzip()) {
-                Some(n) => bar(&what, n, true),
-                None => spinner(&what),
-            };
-            let read = t.decoded_counter();
-            let m = follow_bytes(&pb, &read, &what, || {
-                t.read_frame_at(FrameIndex::from(self.frame))
-            })?;
-            let frames = if count_frames {
-                pb.set_message(format!("counting the frames of {}", path.display()));
-                let before = read.load(std::sync::atomic::Ordering::Relaxed);
-                if let Some(n) = bytes.filter(|_| !t.is_gzip()) {
-                    pb.set_length(n + before);
-                }
-                follow_bytes(&pb, &read, "counting frames", || t.count_frames())?
-            } else {
-                0
-            };
-            pb.finish_and_clear();
-            let w = t.warnings().to_vec();
-            (
-                path.display().to_string(),
-                m,
-                frames,
-                w,
-                Some(t.format()),
-                bytes,
-            )
-        };
-        let load_s = t0.elapsed().as_secs_f64();
-        for w in &warnings {
-            pb.suspend(|| eprintln!("warning: {w}"));
-        }
-        pb.finish_and_clear();
-        Ok(Loaded {
-            source,
-            molecule: m,
-            frames,
-            warnings,
-            format,
-            file_bytes,
-            bonds: Vec::new(),
-            load_s,
-            bond_s: 0.0,
-            unwrap: None,
+    /// Where the atoms come from (a file, else the scene, else nanobowl).
+    pub fn input(&self) -> anyhow::Result<Input> {
+        Ok(match (&self.file, self.scene) {
+            (Some(path), _) => Input::File {
+                path: path.clone(),
+                options: self.read_options()?,
+            },
+            (None, name) => Input::Builtin {
+                name: name.unwrap_or(SceneName::Nanobowl),
+                atoms: self.atoms,
+                seed: self.seed,
+            },
         })
+    }
+
+    /// Loads `--frame` with a bar per stage and prints the reader's warnings; `count_frames`
+    /// also scans the whole file for the number of frames, `bond` builds the bonds (and
+    /// unwraps) as `info` describes them.
+    pub fn load(&self, count_frames: bool, bond: bool) -> anyhow::Result<LoadedFrame> {
+        let bonds = self.bond_settings()?;
+        let input = self.input()?;
+        let title = match &input {
+            Input::File { path, .. } => path.display().to_string(),
+            Input::Builtin { name, .. } => name.to_string(),
+        };
+        let mut l = follow_stages(&title, |p| input.load(self.frame, count_frames, p))?;
+        for w in &l.warnings {
+            eprintln!("warning: {w}");
+        }
+        if bond {
+            let pb = spinner(&format!("building bonds for {} atoms", l.molecule.len()));
+            l.bond(&bonds)?;
+            pb.finish_and_clear();
+        }
+        Ok(l)
     }
 }

@@ -5,7 +5,7 @@
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use render::{Camera, Look, Material, Mode, SecondaryTraversal};
-use scene::{Orbit, Sphere, ViewPreset};
+use scene::{CameraChoice, Orbit, ViewPreset};
 use volume::{Light, TransferFunction};
 
 use crate::pipeline::{GeometryArgs, VolumeArgs};
@@ -228,21 +228,25 @@ impl LookArgs {
         })
     }
 
-    /// The camera of the flags: `--camera`, else the preset fitted to `sphere` with `--orbit`,
-    /// `--zoom` and `--fov` at the aspect of `--size`.
-    pub fn camera(&self, sphere: Sphere) -> Result<Camera> {
+    /// The camera the flags ask for: `--camera`, else the view fitted to the first frame
+    /// (`fit_all`: to every frame rendered).
+    pub fn camera_choice(&self, fit_all: bool) -> Result<CameraChoice> {
         if let Some(spec) = &self.camera {
-            return Ok(spec.parse::<Camera>()?);
+            return Ok(CameraChoice::Fixed(spec.parse::<Camera>()?));
         }
-        let (view, orbit) = self.view_and_orbit();
-        let (w, h) = self.size;
-        Ok(Camera::fit(
-            view,
-            sphere,
-            self.fov,
-            w as f32 / h as f32,
-            orbit,
-        ))
+        let ((view, orbit), fov_deg) = (self.view_and_orbit(), self.fov);
+        Ok(match fit_all {
+            false => CameraChoice::Fit {
+                view,
+                orbit,
+                fov_deg,
+            },
+            true => CameraChoice::FitAll {
+                view,
+                orbit,
+                fov_deg,
+            },
+        })
     }
 
     /// The preset's distance and the orbit of `--view`, `--orbit` and `--zoom`.

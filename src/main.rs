@@ -8,7 +8,6 @@ mod bench_cmd;
 mod generate;
 mod info;
 mod input;
-mod isa_cmd;
 mod look;
 mod pipeline;
 mod progress;
@@ -93,7 +92,10 @@ fn run(cli: Cli) -> Result<()> {
         return Ok(());
     }
     match cli.command {
-        Some(Command::Isa) => isa_cmd::run(isa),
+        Some(Command::Isa) => {
+            print!("{}", Isa::table(isa));
+            Ok(())
+        }
         Some(Command::Info(args)) => info::run(args),
         Some(Command::Render(args)) => render_cmd::run(*args, isa),
         Some(Command::View(args)) => view_cmd::run(*args, isa),
@@ -111,4 +113,10 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The `-v` line of the backend and the threads rendering.
+fn isa_line(isa: spmd::Isa) -> String {
+    let threads = rayon::current_num_threads();
+    format!("isa:     {isa} ({} lanes), {threads} threads", isa.lanes())
 }

@@ -4,6 +4,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, RecvTimeoutError};
+use std::sync::Arc;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -20,14 +21,10 @@ pub fn spinner(msg: &str) -> ProgressBar {
     pb
 }
 
-/// A bar of `len` steps with `msg`, the percentage and the time left; `bytes` counts in bytes.
-pub fn bar(msg: &str, len: u64, bytes: bool) -> ProgressBar {
+/// A bar of `len` steps with `msg`, the percentage and the time left.
+pub fn bar(msg: &str, len: u64) -> ProgressBar {
     let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    let template = if bytes {
-        "{msg} [{bar:30}] {bytes}/{total_bytes} ({elapsed}, {eta} left)"
-    } else {
-        "{msg} [{bar:30}] {percent}% ({elapsed}, {eta} left)"
-    };
+    let template = "{msg} [{bar:30}] {percent}% ({elapsed}, {eta} left)";
     if let Ok(style) = ProgressStyle::with_template(template) {
         pb.set_style(style.progress_chars("=> "));
     }
@@ -38,12 +35,7 @@ pub fn bar(msg: &str, len: u64, bytes: bool) -> ProgressBar {
 
 /// Runs `work` while `pb` follows the byte count `read` (every 0.2 s): as its position when
 /// the bar has a length, else in its message after `what`.
-pub fn follow_bytes<T>(
-    pb: &ProgressBar,
-    read: &AtomicU64,
-    what: &str,
-    work: impl FnOnce() -> T,
-) -> T {
+fn follow_bytes<T>(pb: &ProgressBar, read: &AtomicU64, what: &str, work: impl FnOnce() -> T) -> T {
     let (done, wait) = channel::<()>();
     std::thread::scope(|s| {
         s.spawn(move || loop {
@@ -64,24 +56,28 @@ pub fn follow_bytes<T>(
     })
 }
 
-/// Runs `work` (a scene build) with a bar per stage: `work` reports through the
-/// [`Progress`] it is given, each stage restarts the bar with its name and units.
-pub fn follow_build<T>(work: impl FnOnce(&Progress) -> T) -> T {
-    let pb = bar("building the scene", 1, false);
-    let done = AtomicU64::new(0);
+/// Runs `work` (a scene build or a load) with a bar per stage headed `title`: `work` reports
+/// through the [`Progress`] it is given, each stage restarts the bar with its name and units
+/// (a stage of unknown length shows the count in its message instead).
+pub fn follow_stages<T>(title: &str, work: impl FnOnce(&Progress) -> T) -> T {
+    let pb = bar(title, 1);
+    let done = Arc::new(AtomicU64::new(0));
     let stage = |s: Stage, units: u64| {
         // Zero the count before the bar's length changes, so no poll shows the last
         // stage's count against this one's length.
         done.store(0, Ordering::Relaxed);
-        pb.set_message(format!("building the scene: {s}"));
+        pb.set_message(format!("{title}: {s}"));
         pb.reset();
-        pb.set_length(units.max(1));
+        match (s, units) {
+            (Stage::Read | Stage::CountFrames, 0) => pb.unset_length(),
+            _ => pb.set_length(units.max(1)),
+        }
     };
     let progress = Progress {
         stage: &stage,
-        done: &done,
+        done: done.clone(),
     };
-    let out = follow_bytes(&pb, &done, "", || work(&progress));
+    let out = follow_bytes(&pb, &done, title, || work(&progress));
     pb.finish_and_clear();
     out
 }

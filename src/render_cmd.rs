@@ -5,9 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use render::{
-    draw_legend, render_frame, render_frame_with_progress, FrameInputs, Framebuffer, Legend,
-};
+use render::{render_scene, Framebuffer};
 use scene::Scene;
 use spmd::Isa;
 
@@ -84,30 +82,20 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     args.look.init_threads()?;
     let look = args.look.look(args.input.pbc)?;
     look.validate()?;
-    let mut input = args.input.clone();
-    if input.file.is_none() && input.scene.is_none() {
-        input.scene = Some(molecule::scenes::SceneName::Nanobowl);
-    }
+    let input = &args.input;
     if args.frames.is_some() || args.follow {
-        return crate::series_cmd::run(&args, &look, &input, isa);
+        return crate::series_cmd::run(&args, &look, input, isa);
     }
-    let output = args.output.clone().unwrap_or_else(|| {
-        let stem = match (&input.file, input.scene) {
-            (Some(f), _) => f
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "bnsview".into()),
-            (None, Some(sc)) => sc.to_string(),
-            _ => "bnsview".into(),
-        };
-        PathBuf::from(format!("{stem}.png"))
-    });
+    let output = match &args.output {
+        Some(o) => o.clone(),
+        None => PathBuf::from(format!("{}.png", input.input()?.stem())),
+    };
     render::ImageFormat::for_output(&output, args.force)?;
     // Check the frame fits before the expensive preprocessing.
     let (w, h) = args.look.size;
     let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
     drop(probe);
-    let l = input.load_frame(false)?;
+    let l = input.load(false, false)?;
     let m = &l.molecule;
     if m.is_empty() {
         bail!("{}: no atoms to render", l.source);
@@ -117,11 +105,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             eprintln!("{msg}");
         }
     };
-    verbose(format!(
-        "isa:     {isa} ({} lanes), {} threads",
-        isa.lanes(),
-        rayon::current_num_threads()
-    ));
+    verbose(crate::isa_line(isa));
     verbose(format!(
         "load:    {:.3} s  {} ({} atoms)",
         l.load_s,
@@ -129,65 +113,40 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         m.len()
     ));
     let settings = look.scene_settings(input.bond_settings()?, args.look.size);
-    let sc = crate::progress::follow_build(|p| Scene::build_with(isa, m, &settings, p))?;
+    let sc = crate::progress::follow_stages("building the scene", |p| {
+        Scene::build_with(isa, m, &settings, p)
+    })?;
     sc.stage_report().into_iter().for_each(verbose);
     // Fit the camera to the scene's bounding sphere (the atoms' one, padded by the density's
     // support, when there is no geometry).
-    let camera = args.look.camera(sc.sphere)?;
+    let camera = args.look.camera_choice(false)?.camera(sc.sphere, (w, h));
     verbose(format!("camera:  --camera {camera}"));
-    let scene = sc.model.as_ref();
-    let vscene = sc.volume_scene(look.march_options());
     let settings = look.render_settings();
-    let inputs = FrameInputs {
-        model: scene,
-        volume: vscene.as_ref(),
-        camera: &camera,
-    };
-    let mut fb = Framebuffer::new(w, h, settings.background_packed())?;
     let pb = crate::progress::bar(
         &format!("rendering {w}x{h} {}", args.look.mode.name()),
         h as u64,
-        false,
     );
+    let legend_ink = args.look.geometry.legend.then(|| look.legend_ink());
     // Bands cost up to ~10-20 % on a 50-150 ms frame (threads idle at each band's end:
     // BENCHMARKS.md, "Progress bands"), so only when a bar can be seen.
-    let stats = if std::io::stderr().is_terminal() {
-        render_frame_with_progress(&inputs, &settings, &mut fb, isa, &mut |done, _| {
-            pb.set_position(done as u64)
-        })?
-    } else {
-        render_frame(&inputs, &settings, &mut fb, isa)?
-    };
+    let mut on_rows = |done: u32, _: u32| pb.set_position(done as u64);
+    let on_rows = std::io::stderr().is_terminal().then_some(&mut on_rows as _);
+    let image = render_scene(&sc, &camera, &settings, (w, h), legend_ink, isa, on_rows)?;
     pb.finish_and_clear();
-    let color = sc.settings.model.as_ref().map(|ms| &ms.color);
-    let range = scene.and_then(|m| m.color_range);
-    if let Some(legend) = color.and_then(|c| Legend::of(c, range)) {
-        let Legend { title, lo, hi, .. } = &legend;
-        verbose(format!(
-            "color:   {title} over --color-range {lo}:{hi} ({:?})",
-            legend.colormap
-        ));
-        if args.look.geometry.legend && draw_legend(&mut fb, &legend, look.legend_ink()).is_none() {
+    if let Some((legend, drawn)) = &image.legend {
+        verbose(legend.describe());
+        if legend_ink.is_some() && !drawn {
             eprintln!(
                 "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
                 render::MIN_LEGEND_FRAME
             );
         }
     }
-    let (secs, spp) = (stats.time.as_secs_f64(), settings.frame_samples());
-    verbose(format!(
-        "render:  {secs:.3} s  {w}x{h} {}{} ({:.1} Mrays/s, {:.2} fps{})",
-        args.look.mode.name(),
-        settings.describe(),
-        stats.mrays_per_s(),
-        stats.fps(),
-        if settings.is_linear() {
-            format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
-        } else {
-            String::new()
-        }
-    ));
-    fb.save(&output)
+    let mode = args.look.mode.name();
+    verbose(image.stats.describe(&settings, (w, h), mode));
+    image
+        .frame
+        .save(&output)
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!(
         "wrote {} ({w}x{h}, {}{}, {isa})",

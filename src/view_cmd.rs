@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use molecule::read::{open, FrameIndex};
 use spmd::Isa;
 use viewer::{FrameSource, Toggles, ViewConfig};
 
@@ -50,45 +49,25 @@ pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
         Some(p) => Some(viewer::script::load(p)?),
         None => None,
     };
-    let mut input = args.input.clone();
-    if input.file.is_none() && input.scene.is_none() {
-        input.scene = Some(molecule::scenes::SceneName::Nanobowl);
-    }
-    let (source, first_frame) = match &input.file {
-        Some(path) => {
-            let mut t = open(path, &input.read_options()?)?;
-            let first = t.resolve_frame(FrameIndex::from(input.frame))?;
-            (FrameSource::File(Box::new(t)), first)
-        }
-        None => {
-            let l = input.load_frame(false)?;
-            (FrameSource::One(Box::new(l.molecule), l.source), 0)
-        }
-    };
-    let toggles = Toggles {
-        mode: look.mode,
-        shadows: look.shadows,
-        ao: look.ao,
-        lit: look.lit,
-        opacity: look.opacity,
-    };
+    let input = &args.input;
+    let (source, first_frame) = FrameSource::open(&input.input()?, input.frame)?;
+    let toggles = Toggles::of(&look);
     // The viewer's toggles set on a copy of the look: every frame is what `render` makes of
     // the same flags.
     let (bonds, size) = (input.bond_settings()?, args.look.size);
     let configure = move |t: &Toggles| {
-        let mut l = look.clone();
-        (l.mode, l.shadows, l.ao, l.lit, l.opacity) = (t.mode, t.shadows, t.ao, t.lit, t.opacity);
+        let l = t.apply(&look);
         l.validate().map_err(|e| e.to_string())?;
         Ok((l.scene_settings(bonds.clone(), size), l.render_settings()))
     };
-    let look = args.look.clone();
+    let camera = args.look.camera_choice(false)?;
     let cfg = ViewConfig {
         size: args.look.size,
         isa,
         toggles,
         ao_samples: args.ao_key_samples.or(args.look.ao).unwrap_or(8),
         configure: Box::new(configure),
-        camera: Box::new(move |sphere| look.camera(sphere).map_err(|e| e.to_string())),
+        camera: Box::new(move |sphere| Ok(camera.camera(sphere, size))),
         first_frame,
         script,
         log: args.log.clone(),

@@ -25,7 +25,7 @@ pub mod report;
 pub mod run;
 
 pub use error::BenchError;
-pub use mode::{expand_modes, BenchMode, ModeSel, TableSel};
+pub use mode::{expand_modes, BenchMode, ModeSel, TableSel, ViewSel};
 pub use plan::{plan, Key, PlanSpec, Tables};
 pub use record::{Measurement, Preprocess};
 pub use run::{run, run_report, Config};

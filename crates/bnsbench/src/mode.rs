@@ -229,6 +229,16 @@ pub fn expand_modes(sel: &[ModeSel]) -> Vec<BenchMode> {
     out
 }
 
+/// Which of the paper's views (Table 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum ViewSel {
+    /// The whole molecule fits in the frame.
+    Far,
+    /// A quarter of the far distance from the centre, the frame filled.
+    Close,
+}
+
 /// Which of the paper's tables to reproduce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]

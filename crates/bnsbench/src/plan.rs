@@ -3,7 +3,7 @@
 
 use molecule::scenes::SceneName;
 
-use crate::mode::{BenchMode, TableSel};
+use crate::mode::{BenchMode, TableSel, ViewSel};
 
 /// A set of the paper's Tables 1, 2 and 3.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -92,8 +92,8 @@ pub struct PlanSpec {
     pub scenes: Option<Vec<SceneName>>,
     /// Modes of Table 3 (default [`BenchMode::PAPER`], quick [`BenchMode::QUICK`]).
     pub modes: Option<Vec<BenchMode>>,
-    /// Views of Table 3, `true` = far (default far, close).
-    pub views: Option<Vec<bool>>,
+    /// Views of Table 3 (default far, close).
+    pub views: Option<Vec<ViewSel>>,
     /// Frame size of Tables 2 and 3 (pixels; default 1024², quick 512²).
     pub size: Option<(u32, u32)>,
     /// Frame sizes of Table 1 (pixels; default 256² … 4096², quick 256² and 512²).
@@ -180,12 +180,13 @@ pub fn plan(a: &PlanSpec, nproc: u32) -> Vec<(Key, Tables)> {
             None if a.quick => BenchMode::QUICK.to_vec(),
             None => BenchMode::PAPER.to_vec(),
         };
-        let views = a.views.clone().unwrap_or_else(|| vec![true, false]);
+        let views = (a.views.clone()).unwrap_or_else(|| vec![ViewSel::Far, ViewSel::Close]);
         let threads = a.threads.clone().unwrap_or_else(|| default_threads.clone());
         for &scene in &scenes {
             for &mode in &modes {
-                for &far in &views {
+                for &view in &views {
                     for &t in &threads {
+                        let far = view == ViewSel::Far;
                         push(key(scene, mode, far, size, t), Tables::T3);
                     }
                 }
@@ -285,7 +286,7 @@ mod tests {
         let modes = |quick: bool, modes: Option<Vec<BenchMode>>| {
             let spec = PlanSpec {
                 scenes: Some(vec![SceneName::Nanobowl]),
-                views: Some(vec![true]),
+                views: Some(vec![ViewSel::Far]),
                 table: TableSel::T3,
                 quick,
                 modes,

@@ -1,7 +1,14 @@
-//! Writers: extended XYZ and LAMMPS text dump (for `bnsview generate`).
+//! Writers: extended XYZ and LAMMPS text dump, one frame or a whole trajectory file (for
+//! `bnsview generate`).
+
+use std::fs::{File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use flate2::write::GzEncoder;
+use flate2::Compression;
 
 use crate::{elements, Molecule};
-use std::io::{self, Write};
 
 fn lattice(m: &Molecule) -> String {
     match &m.cell {
@@ -110,4 +117,113 @@ pub fn write_lammps_dump<W: Write + ?Sized>(
         )?;
     }
     Ok(())
+}
+
+/// Why a trajectory file could not be created.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The name says neither XYZ nor LAMMPS dump.
+    #[error("{}: unknown output format; use a .xyz or .lammpstrj name (optionally .gz)", path.display())]
+    UnknownFormat {
+        /// The file name given.
+        path: PathBuf,
+    },
+    /// The file exists and overwriting was not asked for.
+    #[error("{} exists; pass --force to overwrite it", path.display())]
+    Exists {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Creating the file failed.
+    #[error("cannot create {}: {source}", path.display())]
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: io::Error,
+    },
+}
+
+/// Where the frames go: buffered, through gzip for a `.gz` name (buffered in front of the
+/// encoder too: the writers make a call per number, and each call into the deflater costs far
+/// more than a copy into a buffer).
+enum Out {
+    Plain(BufWriter<File>),
+    Gzip(BufWriter<GzEncoder<BufWriter<File>>>),
+}
+
+/// A trajectory file being written, frame by frame: extended XYZ (`.xyz`, `.extxyz`) or
+/// LAMMPS dump (`.lammpstrj`, `.dump`), gzip-compressed when the name ends in `.gz`.
+pub struct TrajectoryWriter {
+    out: Out,
+    xyz: bool,
+    frames: u64,
+}
+
+impl TrajectoryWriter {
+    /// Creates `path` (an existing file only with `force`), its format from its name.
+    pub fn create(path: &Path, force: bool) -> Result<TrajectoryWriter, WriteError> {
+        let name = path.to_string_lossy().to_ascii_lowercase();
+        let base = name.strip_suffix(".gz").unwrap_or(&name);
+        let xyz = if base.ends_with(".xyz") || base.ends_with(".extxyz") {
+            true
+        } else if base.ends_with(".lammpstrj") || base.ends_with(".dump") {
+            false
+        } else {
+            return Err(WriteError::UnknownFormat { path: path.into() });
+        };
+        let mut opts = OpenOptions::new();
+        opts.write(true);
+        if force {
+            opts.create(true).truncate(true);
+        } else {
+            opts.create_new(true);
+        }
+        let file = opts.open(path).map_err(|source| match source.kind() {
+            io::ErrorKind::AlreadyExists => WriteError::Exists { path: path.into() },
+            _ => WriteError::Create {
+                path: path.into(),
+                source,
+            },
+        })?;
+        let buf = BufWriter::with_capacity(1 << 20, file);
+        let out = if name.ends_with(".gz") {
+            let e = GzEncoder::new(buf, Compression::fast());
+            Out::Gzip(BufWriter::with_capacity(1 << 20, e))
+        } else {
+            Out::Plain(buf)
+        };
+        Ok(TrajectoryWriter {
+            out,
+            xyz,
+            frames: 0,
+        })
+    }
+
+    /// Appends frame `m` (the XYZ comment line is `comment` and the frame number; the
+    /// LAMMPS timestep is the frame number).
+    pub fn write(&mut self, m: &Molecule, comment: &str) -> io::Result<()> {
+        let w: &mut dyn Write = match &mut self.out {
+            Out::Plain(w) => w,
+            Out::Gzip(w) => w,
+        };
+        if self.xyz {
+            write_xyz(w, m, &format!("{comment} frame {}", self.frames))?;
+        } else {
+            write_lammps_dump(w, m, self.frames)?;
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Flushes the buffers and ends the gzip stream.
+    pub fn finish(self) -> io::Result<()> {
+        match self.out {
+            Out::Plain(mut b) => b.flush(),
+            Out::Gzip(e) => {
+                let e = e.into_inner().map_err(|e| e.into_error())?;
+                e.finish()?.flush()
+            }
+        }
+    }
 }

@@ -89,6 +89,24 @@ impl RenderStats {
     pub fn fps(&self) -> f64 {
         1.0 / self.time.as_secs_f64().max(1e-12)
     }
+
+    /// One line for `-v`: the time, the frame (`size` pixels, `mode` as named on the command
+    /// line, the settings), rays per second, frames per second, and per sample for the
+    /// progressive modalities.
+    pub fn describe(&self, set: &RenderSettings, size: (u32, u32), mode: &str) -> String {
+        let (secs, spp, (w, h)) = (self.time.as_secs_f64(), set.frame_samples(), size);
+        let per_sample = if set.is_linear() {
+            format!(", {spp} spp, {:.3} s per spp", secs / spp.max(1) as f64)
+        } else {
+            String::new()
+        };
+        format!(
+            "render:  {secs:.3} s  {w}x{h} {mode}{} ({:.1} Mrays/s, {:.2} fps{per_sample})",
+            set.describe(),
+            self.mrays_per_s(),
+            self.fps(),
+        )
+    }
 }
 
 /// Renders the whole frame into `fb` (its size is the frame's): the headlight modes write

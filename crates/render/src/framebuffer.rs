@@ -30,6 +30,9 @@ pub enum RenderError {
         /// Its missing directory.
         dir: String,
     },
+    /// The render settings are refused (see [`crate::SettingsError`]).
+    #[error(transparent)]
+    Settings(#[from] crate::SettingsError),
 }
 
 /// An image file format a frame is written in.

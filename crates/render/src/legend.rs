@@ -174,3 +174,14 @@ fn text(fb: &mut Framebuffer, s: &str, x: u32, y: u32, scale: u32, px: u32) {
         }
     }
 }
+
+impl Legend {
+    /// One line for `-v`: the column, the range (as the flag that repeats it) and the colormap.
+    pub fn describe(&self) -> String {
+        let Legend { title, lo, hi, .. } = self;
+        format!(
+            "color:   {title} over --color-range {lo}:{hi} ({:?})",
+            self.colormap
+        )
+    }
+}

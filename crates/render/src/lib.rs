@@ -18,6 +18,7 @@ mod legend;
 mod look;
 mod progress;
 mod rng;
+mod scene_image;
 mod settings;
 
 pub use accum::Accum;
@@ -33,6 +34,7 @@ pub use progress::{render_frame_with_progress, PROGRESS_BANDS};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };
+pub use scene_image::{render_scene, SceneImage};
 pub use settings::{
     Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,
     DIRECT_AMBIENT, HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP, WHITE_BACKGROUND,

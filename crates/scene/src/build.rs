@@ -3,6 +3,7 @@
 //! light volume (paper §4.1 steps 3-5), with per-stage timings and a memory check first.
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use molecule::bonds::{try_build_bonds_with_progress, BondOptions};
@@ -35,6 +36,13 @@ pub enum Stage {
     Macrocells,
     /// Light volume.
     LightVolume,
+    /// Generating a built-in scene ([`crate::Input::load`]; 1 unit).
+    Generate,
+    /// Reading a frame of a file (bytes decoded; 0 units when the size is not known up
+    /// front, as for a gzip file).
+    Read,
+    /// Scanning the whole file for its number of frames (bytes decoded; 0 when unknown).
+    CountFrames,
 }
 
 impl std::fmt::Display for Stage {
@@ -45,6 +53,9 @@ impl std::fmt::Display for Stage {
             Stage::Volume => "density volume",
             Stage::Macrocells => "macrocells",
             Stage::LightVolume => "light volume",
+            Stage::Generate => "generating",
+            Stage::Read => "reading",
+            Stage::CountFrames => "counting the frames",
         })
     }
 }
@@ -54,17 +65,25 @@ impl std::fmt::Display for Stage {
 /// slab passes of the density, z-planes of the light volume, 1 for macrocells); the stage adds
 /// the units it finishes to `done`, which is set to 0 after `stage` returns (so `stage` still
 /// reads the last stage's count) and before the work starts, so another thread can draw a
-/// bar from the two.
+/// bar from the two. [`crate::Input::load`] reports through it too.
 pub struct Progress<'a> {
     /// Called as each stage starts with its total units.
     pub stage: &'a dyn Fn(Stage, u64),
-    /// Units finished in the running stage.
-    pub done: &'a AtomicU64,
+    /// Units finished in the running stage (shared: a file reader counts into it).
+    pub done: Arc<AtomicU64>,
 }
 
 impl Progress<'_> {
+    /// Progress reported nowhere.
+    pub fn none() -> Progress<'static> {
+        Progress {
+            stage: &|_, _| {},
+            done: Arc::new(AtomicU64::new(0)),
+        }
+    }
+
     /// Announces `stage` of `total` units and resets `done`.
-    fn start(&self, stage: Stage, total: u64) {
+    pub(crate) fn start(&self, stage: Stage, total: u64) {
         (self.stage)(stage, total);
         self.done.store(0, Ordering::Relaxed);
     }
@@ -127,12 +146,7 @@ pub struct Scene {
 impl Scene {
     /// Builds the scene of `m` with backend `isa` (density and light volume kernels).
     pub fn build(isa: Isa, m: &Molecule, settings: &SceneSettings) -> Result<Scene, SceneError> {
-        let done = AtomicU64::new(0);
-        let progress = Progress {
-            stage: &|_, _| {},
-            done: &done,
-        };
-        Scene::build_with(isa, m, settings, &progress)
+        Scene::build_with(isa, m, settings, &Progress::none())
     }
 
     /// [`Scene::build`] reporting each stage and its work done to `progress`.
@@ -165,12 +179,7 @@ impl Scene {
     /// Vec (refilled in place for file bonds) and the per-atom radius and colour scratch; the
     /// BVH, volume and light volume are built anew (their builders allocate).
     pub fn rebuild(&mut self, isa: Isa, m: &Molecule) -> Result<(), SceneError> {
-        let done = AtomicU64::new(0);
-        let progress = Progress {
-            stage: &|_, _| {},
-            done: &done,
-        };
-        self.rebuild_with(isa, m, &progress)
+        self.rebuild_with(isa, m, &Progress::none())
     }
 
     /// [`Scene::rebuild`] reporting each stage and its work done to `progress`.
@@ -203,7 +212,7 @@ impl Scene {
             keep_crossing,
             m,
             &mut self.bonds,
-            progress.done,
+            &progress.done,
         )?;
         self.timings.bonds = t.elapsed().as_secs_f64();
         // From here on the frame is the unwrapped one (model, volume, camera sphere).
@@ -235,7 +244,7 @@ impl Scene {
             let prims = model_prim_count(m.len(), self.bonds.len(), ms).1;
             progress.start(Stage::Model, prims as u64);
             let t = Instant::now();
-            let model = build_model(m, &self.bonds, ms, &mut self.scratch, progress.done)?;
+            let model = build_model(m, &self.bonds, ms, &mut self.scratch, &progress.done)?;
             if ms.wide_bvh {
                 model.wide();
             }
@@ -255,7 +264,7 @@ impl Scene {
                 vs,
                 st.budget_bytes,
                 &mut self.scratch.0,
-                progress.done,
+                &progress.done,
             )?;
             self.timings.volume = t.elapsed().as_secs_f64();
             progress.start(Stage::Macrocells, 1);
@@ -293,7 +302,7 @@ impl Scene {
                     &scene,
                     lv.shadows(),
                     lv.stride,
-                    progress.done,
+                    &progress.done,
                 ));
                 self.timings.light_volume = t.elapsed().as_secs_f64();
             }

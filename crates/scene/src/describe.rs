@@ -3,42 +3,11 @@
 //! ([`MemoryEstimate`], the figure the build's refusal uses), as text or JSON.
 
 use molecule::elements;
-use molecule::read::Format;
-use molecule::Molecule;
 
-use crate::build::UnwrapReport;
+use crate::input::LoadedFrame;
 use crate::memory::MemoryEstimate;
 use crate::settings::{BondSettings, ModelSettings, SceneSettings, VolumeSettings};
 use crate::SceneError;
-
-/// A loaded frame and what loading it took.
-#[derive(Clone, Copy, Debug)]
-pub struct LoadedFrame<'a> {
-    /// Human description of the source (path, or scene and seed).
-    pub source: &'a str,
-    /// Format of the file, if one was read.
-    pub format: Option<Format>,
-    /// File size in bytes, if one was read.
-    pub file_bytes: Option<u64>,
-    /// Index of the frame as asked (negative: from the end).
-    pub frame: i64,
-    /// Frames in the input (1 for a built-in scene).
-    pub frames: usize,
-    /// The frame.
-    pub molecule: &'a Molecule,
-    /// Its bonds (pairs i < j).
-    pub bonds: &'a [[u32; 2]],
-    /// How the bonds were made.
-    pub bond_settings: &'a BondSettings,
-    /// How the frame was unwrapped (`None`: it was not).
-    pub unwrap: Option<&'a UnwrapReport>,
-    /// Time to read or generate the frame (s).
-    pub load_s: f64,
-    /// Time to build the bonds (s), unwrapping included.
-    pub bond_s: f64,
-    /// Reader warnings.
-    pub warnings: &'a [String],
-}
 
 /// The frame `render` would draw, for the estimates: size in pixels and u8 volume resolution.
 #[derive(Clone, Copy, Debug)]
@@ -52,8 +21,10 @@ pub struct EstimateFor {
 /// A frame described for `bnsview info`.
 #[derive(Clone, Debug)]
 pub struct Description<'a> {
-    /// The frame.
-    pub frame: LoadedFrame<'a>,
+    /// The frame, with its bonds.
+    pub frame: &'a LoadedFrame,
+    /// How the bonds were made.
+    pub bond_settings: &'a BondSettings,
     /// What the estimates assume.
     pub target: EstimateFor,
     /// Per `render` mode (`bs`, `volume`, `vol+bs`, `path`), the estimate `render` checks
@@ -62,9 +33,13 @@ pub struct Description<'a> {
 }
 
 impl<'a> Description<'a> {
-    /// Estimates every mode for `frame` at `target` (default model and volume settings, the
-    /// frame's bond settings). Errors: the density grid cannot be laid out.
-    pub fn new(frame: LoadedFrame<'a>, target: EstimateFor) -> Result<Self, SceneError> {
+    /// Estimates every mode for `frame` (bonded with `bond_settings`) at `target` (default
+    /// model and volume settings). Errors: the density grid cannot be laid out.
+    pub fn new(
+        frame: &'a LoadedFrame,
+        bond_settings: &'a BondSettings,
+        target: EstimateFor,
+    ) -> Result<Self, SceneError> {
         let model = |wide_bvh| {
             Some(ModelSettings {
                 wide_bvh,
@@ -86,16 +61,17 @@ impl<'a> Description<'a> {
                 let settings = SceneSettings {
                     model,
                     volume,
-                    bonds: frame.bond_settings.clone(),
+                    bonds: bond_settings.clone(),
                     frame: Some(target.size),
                     ..Default::default()
                 };
-                let e = MemoryEstimate::new(frame.molecule, frame.bonds.len(), &settings)?;
+                let e = MemoryEstimate::new(&frame.molecule, frame.bonds.len(), &settings)?;
                 Ok((name, e))
             })
             .collect::<Result<_, SceneError>>()?;
         Ok(Description {
             frame,
+            bond_settings,
             target,
             modes,
         })
@@ -109,7 +85,7 @@ impl<'a> Description<'a> {
 
     /// Atoms per element symbol, in element order.
     fn element_counts(&self) -> Vec<(&'static str, usize)> {
-        let m = self.frame.molecule;
+        let m = &self.frame.molecule;
         let counts = m.element_counts().into_iter();
         counts
             .map(|(z, c)| (elements::element(z).symbol, c))
@@ -129,7 +105,7 @@ impl<'a> Description<'a> {
     /// The description as one JSON object (what `info --json` prints).
     pub fn json(&self) -> serde_json::Value {
         use serde_json::{json, Map, Value};
-        let (f, m, est) = (&self.frame, self.frame.molecule, self.largest());
+        let (f, m, est) = (self.frame, &self.frame.molecule, self.largest());
         let (lo, hi) = m.bounds();
         let elements: Map<String, Value> = (self.element_counts().into_iter())
             .map(|(s, c)| (s.to_string(), json!(c)))
@@ -168,8 +144,8 @@ impl<'a> Description<'a> {
             "file_bonds": m.file_bonds.as_ref().map(Vec::len),
             "bonds": f.bonds.len(),
             "bonds_per_atom": self.bonds_per_atom(),
-            "bond_source": format!("{:?}", f.bond_settings.source).to_lowercase(),
-            "pbc": f.bond_settings.options.pbc,
+            "bond_source": format!("{:?}", self.bond_settings.source).to_lowercase(),
+            "pbc": self.bond_settings.options.pbc,
             "unwrap": f.unwrap.map(|u| json!({
                 "method": format!("{:?}", u.method).to_lowercase(),
                 "crossing_bonds": u.crossing,
@@ -185,7 +161,7 @@ impl<'a> Description<'a> {
 
     /// The description as aligned text lines (what `info` prints).
     pub fn text(&self) -> String {
-        let (f, m) = (&self.frame, self.frame.molecule);
+        let (f, m) = (self.frame, &self.frame.molecule);
         let mut out = String::new();
         let mut line = |s: String| {
             out.push_str(&s);
@@ -198,7 +174,8 @@ impl<'a> Description<'a> {
         }
         line(format!(
             "frames:    {} (showing frame {})",
-            f.frames, f.frame
+            f.frames.map_or("not counted".into(), |n| n.to_string()),
+            f.frame
         ));
         line(format!("atoms:     {}", m.len()));
         let el: Vec<String> = (self.element_counts().iter())
@@ -220,7 +197,7 @@ impl<'a> Description<'a> {
         if let Some(fb) = &m.file_bonds {
             line(format!("file bonds: {}", fb.len()));
         }
-        let pbc = if f.bond_settings.options.pbc {
+        let pbc = if self.bond_settings.options.pbc {
             ", pbc"
         } else {
             ""
@@ -229,10 +206,10 @@ impl<'a> Description<'a> {
             "bonds:     {} ({:.3} per atom, {:?}{pbc}) built in {:.3} s",
             f.bonds.len(),
             self.bonds_per_atom(),
-            f.bond_settings.source,
+            self.bond_settings.source,
             f.bond_s
         ));
-        if let Some(u) = f.unwrap {
+        if let Some(u) = &f.unwrap {
             line(u.describe().replacen("unwrap:  ", "unwrap:    ", 1));
         }
         match f.file_bytes {

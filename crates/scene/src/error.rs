@@ -1,6 +1,6 @@
 //! Why a scene could not be built.
 
-/// Errors of [`crate::Scene::build`].
+/// Errors of [`crate::Scene::build`] and [`crate::Input::load`].
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A setting is out of range.
@@ -56,6 +56,18 @@ pub enum SceneError {
         budget: u64,
         /// The largest components, human readable.
         breakdown: String,
+    },
+    /// Reading the input file failed (file, line, what was expected).
+    #[error(transparent)]
+    Read(Box<molecule::read::ReadError>),
+    /// A built-in scene could not be generated (too many atoms for the limit or the memory).
+    #[error(transparent)]
+    Generate(#[from] molecule::scenes::SceneError),
+    /// A frame other than 0 of a built-in scene.
+    #[error("--frame {frame}: built-in scenes have a single frame")]
+    OneFrame {
+        /// The frame asked for.
+        frame: i64,
     },
     /// The density volume failed (bad input, resolution or over its own budget).
     #[error("building the density volume: {0}")]

@@ -195,6 +195,53 @@ impl Camera {
     }
 }
 
+/// How the camera of a frame or a series is chosen: given, or fitted to the atoms.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CameraChoice {
+    /// This camera for every frame.
+    Fixed(Camera),
+    /// Fitted to the sphere holding every frame to be rendered (a first pass through the
+    /// file finds it; not possible when following a file).
+    FitAll {
+        /// Distance preset.
+        view: View,
+        /// Direction and zoom around the centre.
+        orbit: Orbit,
+        /// Vertical field of view (degrees).
+        fov_deg: f32,
+    },
+    /// Fitted once, to the first rendered frame's bounding sphere.
+    Fit {
+        /// Distance preset.
+        view: View,
+        /// Direction and zoom around the centre.
+        orbit: Orbit,
+        /// Vertical field of view (degrees).
+        fov_deg: f32,
+    },
+}
+
+impl CameraChoice {
+    /// The camera for atoms within `sphere` in an image of `size` pixels: the fixed one, or
+    /// the view fitted to `sphere` ([`CameraChoice::FitAll`]: the caller passes the sphere
+    /// holding every frame).
+    pub fn camera(&self, sphere: Sphere, size: (u32, u32)) -> Camera {
+        match *self {
+            CameraChoice::Fixed(c) => c,
+            CameraChoice::Fit {
+                view,
+                orbit,
+                fov_deg,
+            }
+            | CameraChoice::FitAll {
+                view,
+                orbit,
+                fov_deg,
+            } => Camera::fit(view, sphere, fov_deg, size.0 as f32 / size.1 as f32, orbit),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,6 +14,7 @@ mod colormap;
 mod describe;
 mod error;
 mod fit;
+mod input;
 mod memory;
 mod model;
 mod periodic;
@@ -24,9 +25,12 @@ pub use build::{DensityVolume, Prepared, Progress, Scene, Stage, Timings, Unwrap
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
-pub use describe::{Description, EstimateFor, LoadedFrame};
+pub use describe::{Description, EstimateFor};
 pub use error::SceneError;
-pub use fit::{ball_sphere, bounding_sphere, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD};
+pub use fit::{
+    ball_sphere, bounding_sphere, CameraChoice, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD,
+};
+pub use input::{Input, LoadedFrame};
 pub use memory::{
     retained_bytes, MemoryEstimate, Peak, PeakPhase, BASELINE_BYTES, BVH_NODES_PER_PRIM,
     WIDE_NODES_PER_PRIM,

@@ -3,7 +3,7 @@
 //! volume formats and with unwrapping; the scene is the same as without progress.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 mod common;
 
@@ -16,7 +16,12 @@ use volume::VolumeFormat;
 /// Builds `st` over `m` and returns each stage with its announced units and the units it
 /// counted (read as the next stage is announced, before the count is reset, or at the end).
 fn stages(m: &molecule::Molecule, st: &SceneSettings) -> (Scene, Vec<(Stage, u64, u64)>) {
-    let done = AtomicU64::new(0);
+    with_stages(|p| Scene::build_with(Isa::Scalar, m, st, p).unwrap())
+}
+
+/// Runs `work` with a progress that records each stage, its units and the units counted.
+fn with_stages<T>(work: impl FnOnce(&Progress) -> T) -> (T, Vec<(Stage, u64, u64)>) {
+    let done = Arc::new(AtomicU64::new(0));
     let seen: Mutex<Vec<(Stage, u64, u64)>> = Mutex::new(Vec::new());
     let stage = |s: Stage, units: u64| {
         let mut v = seen.lock().unwrap();
@@ -27,14 +32,14 @@ fn stages(m: &molecule::Molecule, st: &SceneSettings) -> (Scene, Vec<(Stage, u64
     };
     let progress = Progress {
         stage: &stage,
-        done: &done,
+        done: done.clone(),
     };
-    let scene = Scene::build_with(Isa::Scalar, m, st, &progress).unwrap();
+    let out = work(&progress);
     let mut v = seen.into_inner().unwrap();
     if let Some(last) = v.last_mut() {
         last.2 = done.load(Ordering::Relaxed);
     }
-    (scene, v)
+    (out, v)
 }
 
 fn settings(format: VolumeFormat, unwrap: bool) -> SceneSettings {
@@ -106,4 +111,44 @@ fn unwrapping_counts_the_bond_search_once() {
     assert_eq!(v[0], (Stage::Bonds, m.len() as u64, m.len() as u64));
     assert_eq!(v[1].0, Stage::Model);
     assert_eq!(v[1].1, v[1].2);
+}
+
+#[test]
+fn loading_counts_the_file_bytes_read_and_scanned() {
+    let dir = std::env::temp_dir().join(format!("bns_progress_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("three.xyz");
+    let m = generate(SceneName::Nanobowl, Some(500), 1);
+    let mut text = Vec::new();
+    for k in 0..3 {
+        molecule::write::write_xyz(&mut text, &m, &format!("frame {k}")).unwrap();
+    }
+    std::fs::write(&path, &text).unwrap();
+    let input = scene::Input::File {
+        path: path.clone(),
+        options: Default::default(),
+    };
+    let bytes = text.len() as u64;
+    let (l, v) = with_stages(|p| input.load(-1, true, p).unwrap());
+    assert_eq!(l.frames, Some(3));
+    assert_eq!(l.molecule.len(), m.len());
+    // The count scans the whole file, exactly its bytes; the read then seeks to the last
+    // frame and reads it, never more than the file.
+    assert_eq!(v[0], (Stage::CountFrames, bytes, bytes));
+    assert_eq!(v[1].0, Stage::Read);
+    assert_eq!(v[1].1, bytes);
+    assert!(v[1].2 > 0 && v[1].2 <= bytes / 2, "{v:?}");
+    let (_, v) = with_stages(|p| input.load(1, false, p).unwrap());
+    assert_eq!(v.len(), 1);
+    assert!(v[0].2 > bytes / 2 && v[0].2 <= bytes, "{v:?}");
+    let builtin = scene::Input::Builtin {
+        name: SceneName::Nanobowl,
+        atoms: Some(100),
+        seed: 1,
+    };
+    let (l, v) = with_stages(|p| builtin.load(0, true, p).unwrap());
+    assert_eq!((l.frames, v), (Some(1), vec![(Stage::Generate, 1, 0)]));
+    let e = builtin.load(1, false, &Progress::none()).unwrap_err();
+    assert!(e.to_string().contains("single frame"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -14,9 +14,12 @@ mod follow;
 mod output;
 mod range;
 mod run;
+mod source;
 
 pub use error::SeriesError;
 pub use follow::{follow_series, FollowSettings};
-pub use output::{expand, OutputKind, Sink, DEFAULT_GIF_FPS};
+pub use output::{default_output, expand, OutputKind, Sink, DEFAULT_GIF_FPS};
 pub use range::{FrameRange, FrameRangeError};
-pub use run::{render_series, CameraChoice, FrameReport, SeriesReport, SeriesSettings};
+pub use run::{render_series, FrameReport, SeriesReport, SeriesSettings};
+pub use scene::CameraChoice;
+pub use source::Source;

@@ -48,6 +48,17 @@ impl OutputKind {
     }
 }
 
+/// The numbered images a series of `input` goes to when no output is given:
+/// `STEM_%05d.png`, STEM the file name up to its first dot.
+pub fn default_output(input: &Path) -> PathBuf {
+    let name = input.file_name().map(|s| s.to_string_lossy().into_owned());
+    let stem = name
+        .as_deref()
+        .and_then(|n| n.split('.').next())
+        .filter(|s| !s.is_empty());
+    PathBuf::from(format!("{}_%05d.png", stem.unwrap_or("bnsview")))
+}
+
 /// `pattern` with its one `%d` / `%0Nd` replaced by `k`; `None` without exactly one.
 pub fn expand(pattern: &str, k: usize) -> Option<String> {
     let start = pattern.find('%')?;

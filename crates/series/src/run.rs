@@ -8,38 +8,12 @@ use std::time::Instant;
 
 use molecule::read::Trajectory;
 use molecule::Molecule;
-use render::{draw_legend, render_frame, Camera, FrameInputs, Framebuffer, Legend, RenderSettings};
-use scene::{ColorBy, Orbit, Scene, SceneSettings, View};
+use render::{render_scene, Camera, RenderSettings};
+use scene::{CameraChoice, ColorBy, Scene, SceneSettings};
 use spmd::Isa;
 
 use crate::fit_all::sphere_of_frames;
 use crate::{FrameRange, SeriesError, Sink};
-
-/// How the camera of the series is chosen.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum CameraChoice {
-    /// This camera for every frame.
-    Fixed(Camera),
-    /// Fitted to the sphere holding every frame to be rendered (a first pass through the
-    /// file finds it; not possible when following a file).
-    FitAll {
-        /// Distance preset.
-        view: View,
-        /// Direction and zoom around the centre.
-        orbit: Orbit,
-        /// Vertical field of view (degrees).
-        fov_deg: f32,
-    },
-    /// Fitted once, to the first rendered frame's bounding sphere.
-    Fit {
-        /// Distance preset.
-        view: View,
-        /// Direction and zoom around the centre.
-        orbit: Orbit,
-        /// Vertical field of view (degrees).
-        fov_deg: f32,
-    },
-}
 
 /// Everything a series is rendered with.
 #[derive(Clone, Debug)]
@@ -224,21 +198,15 @@ pub fn render_series(
     let fitted;
     let mut fitted_to = None;
     let s = match s.camera {
-        CameraChoice::FitAll {
-            view,
-            orbit,
-            fov_deg,
-        } => {
+        CameraChoice::FitAll { .. } => {
             let sphere = traj
                 .reopen()
                 .map_err(SeriesError::from)
                 .and_then(|mut t| sphere_of_frames(&mut t, &s.frames, &s.scene));
             let sphere = sphere.inspect_err(|_| sink.abandon())?;
             fitted_to = Some(sphere);
-            let (w, h) = s.size;
-            let camera = Camera::fit(view, sphere, fov_deg, w as f32 / h as f32, orbit);
             fitted = SeriesSettings {
-                camera: CameraChoice::Fixed(camera),
+                camera: CameraChoice::Fixed(s.camera.camera(sphere, s.size)),
                 ..s.clone()
             };
             &fitted
@@ -287,22 +255,10 @@ fn run_series(
     let Some(first) = read_and_build(frames, &settings, s.isa)? else {
         return Err(frames.none_error());
     };
-    let (w, h) = s.size;
-    let camera = match s.camera {
-        CameraChoice::Fixed(c) => c,
-        CameraChoice::FitAll { .. } => return Err(SeriesError::FitAllFollow),
-        CameraChoice::Fit {
-            view,
-            orbit,
-            fov_deg,
-        } => Camera::fit(
-            view,
-            first.scene.sphere,
-            fov_deg,
-            w as f32 / h as f32,
-            orbit,
-        ),
-    };
+    if matches!(s.camera, CameraChoice::FitAll { .. }) {
+        return Err(SeriesError::FitAllFollow);
+    }
+    let camera = s.camera.camera(first.scene.sphere, s.size);
     let color_range = first.scene.model.as_ref().and_then(|m| m.color_range);
     if let Some(ms) = settings.model.as_mut() {
         if let ColorBy::Column { range, .. } = &mut ms.color {
@@ -320,27 +276,22 @@ fn run_series(
         density_max,
         ..SeriesReport::default()
     };
-    let legend = (settings.model.as_ref())
-        .and_then(|ms| Legend::of(&ms.color, color_range))
-        .zip(s.legend_ink);
     let mut render_one = |b: Built, wait_s: f64| -> Result<(), SeriesError> {
         let t = Instant::now();
-        let vscene = b.scene.volume_scene(s.render.march);
-        let inputs = FrameInputs {
-            model: b.scene.model.as_ref(),
-            volume: vscene.as_ref(),
-            camera: &camera,
-        };
-        let mut fb = Framebuffer::new(w, h, s.render.background_packed())?;
-        render_frame(&inputs, &s.render, &mut fb, s.isa)?;
-        if let Some((l, ink)) = &legend {
-            draw_legend(&mut fb, l, *ink);
-        }
+        let image = render_scene(
+            &b.scene,
+            &camera,
+            &s.render,
+            s.size,
+            s.legend_ink,
+            s.isa,
+            None,
+        )?;
         let render_s = t.elapsed().as_secs_f64();
         let unwrap = b.scene.unwrap;
         drop(b.scene);
         let t = Instant::now();
-        let path = sink.write(b.frame, &fb)?;
+        let path = sink.write(b.frame, &image.frame)?;
         let r = FrameReport {
             frame: b.frame,
             atoms: b.atoms,

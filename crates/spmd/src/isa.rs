@@ -95,6 +95,25 @@ impl Isa {
         }
     }
 
+    /// A table of the backends (`bnsview isa`): one line each with its lanes, whether this
+    /// CPU supports it, and a `*` on `selected`.
+    pub fn table(selected: Isa) -> String {
+        let mut t = format!(
+            "{:<8} {:>5}  {:<9}  selected\n",
+            "isa", "lanes", "supported"
+        );
+        for isa in Isa::ALL {
+            let supported = if isa.is_supported() { "yes" } else { "no" };
+            let star = if isa == selected { "*" } else { "" };
+            t += &format!(
+                "{:<8} {:>5}  {supported:<9}  {star}\n",
+                isa.name(),
+                isa.lanes()
+            );
+        }
+        t
+    }
+
     /// The backends this machine supports, narrowest first.
     pub fn supported() -> Vec<Isa> {
         Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()

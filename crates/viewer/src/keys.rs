@@ -1,7 +1,7 @@
 //! What the keys do: key names (shared by the window and `--script`'s `key NAME`), the
 //! actions they stand for, and the display toggles they change.
 
-use render::Mode;
+use render::{Look, Mode};
 
 /// The next mode of the `v` key: bs → vol+bs → volume → path → bs.
 pub fn next_mode(m: Mode) -> Mode {
@@ -29,6 +29,27 @@ pub struct Toggles {
 }
 
 impl Toggles {
+    /// The toggles as `look` sets them.
+    pub fn of(look: &Look) -> Toggles {
+        let (mode, shadows, ao, lit, opacity) =
+            (look.mode, look.shadows, look.ao, look.lit, look.opacity);
+        Toggles {
+            mode,
+            shadows,
+            ao,
+            lit,
+            opacity,
+        }
+    }
+
+    /// `look` with these toggles: what `render` draws with the same flags.
+    pub fn apply(&self, look: &Look) -> Look {
+        let mut l = look.clone();
+        (l.mode, l.shadows, l.ao, l.lit, l.opacity) =
+            (self.mode, self.shadows, self.ao, self.lit, self.opacity);
+        l
+    }
+
     /// What the mode can show of these toggles: shadows and AO only on balls and sticks
     /// (bs, vol+bs), lighting and opacity only of a volume (volume, vol+bs). The toggles keep
     /// the user's choices, so switching back to a mode restores them.

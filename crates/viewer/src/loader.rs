@@ -7,9 +7,9 @@ use std::sync::mpsc::{channel, Receiver, Sender, TryRecvError};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use molecule::read::Trajectory;
+use molecule::read::{FrameIndex, Trajectory};
 use molecule::Molecule;
-use scene::{Scene, SceneSettings};
+use scene::{Scene, SceneError, SceneSettings};
 use spmd::Isa;
 
 /// Where the time steps come from.
@@ -21,6 +21,22 @@ pub enum FrameSource {
 }
 
 impl FrameSource {
+    /// The time steps of `input` and the index of its frame `frame` (negative: from the end):
+    /// a file is opened (its frames read as they are shown), a built-in scene generated.
+    pub fn open(input: &scene::Input, frame: i64) -> Result<(FrameSource, usize), SceneError> {
+        match input {
+            scene::Input::File { path, options } => {
+                let mut t = molecule::read::open(path, options)?;
+                let first = t.resolve_frame(FrameIndex::from(frame))?;
+                Ok((FrameSource::File(Box::new(t)), first))
+            }
+            scene::Input::Builtin { .. } => {
+                let l = input.load(frame, false, &scene::Progress::none())?;
+                Ok((FrameSource::One(Box::new(l.molecule), l.source), 0))
+            }
+        }
+    }
+
     /// Human name of the source.
     pub fn name(&self) -> String {
         match self {

@@ -429,13 +429,22 @@ fn empty_error(path: &Path, format: Format) -> ReadError {
 
 /// Open a trajectory. Frames are parsed lazily; see [`Trajectory`].
 pub fn open(path: &Path, opts: &ReadOptions) -> Result<Trajectory, ReadError> {
+    open_counted(path, opts, Arc::new(AtomicU64::new(0)))
+}
+
+/// [`open`] adding every byte it decodes to `decoded` (a count shared with a progress
+/// display; [`Trajectory::decoded_counter`] returns it).
+pub fn open_counted(
+    path: &Path,
+    opts: &ReadOptions,
+    decoded: Arc<AtomicU64>,
+) -> Result<Trajectory, ReadError> {
     let format = match opts.format.or_else(|| Format::from_path(path)) {
         Some(f) => f,
         None => sniff(path)?.ok_or_else(|| ReadError::UnknownFormat {
             path: path.to_path_buf(),
         })?,
     };
-    let decoded = Arc::new(AtomicU64::new(0));
     let (src, gz) = open_stream(path, 0, &decoded)?;
     let path: Arc<Path> = Arc::from(path);
     let reader = LineReader::new(src, path.clone());
@@ -509,12 +518,6 @@ impl Trajectory {
     /// decodes its (uncompressed) size once.
     pub fn decoded_bytes(&self) -> u64 {
         self.decoded.load(Ordering::Relaxed)
-    }
-
-    /// The live count behind [`Trajectory::decoded_bytes`], for a progress display on another
-    /// thread while this one reads.
-    pub fn decoded_counter(&self) -> Arc<AtomicU64> {
-        self.decoded.clone()
     }
 
     /// A new trajectory over the same file with the same options, at its first frame (its

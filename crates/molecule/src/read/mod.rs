@@ -433,7 +433,7 @@ pub fn open(path: &Path, opts: &ReadOptions) -> Result<Trajectory, ReadError> {
 }
 
 /// [`open`] adding every byte it decodes to `decoded` (a count shared with a progress
-/// display; [`Trajectory::decoded_counter`] returns it).
+/// display, such as [`Trajectory::decoded_bytes`] reads).
 pub fn open_counted(
     path: &Path,
     opts: &ReadOptions,

@@ -11,8 +11,8 @@ use spmd::Isa;
 
 use bnsbench::{expand_modes, Config, ModeSel, PlanSpec, TableSel, ViewSel};
 
-use crate::look::parse_size;
 use crate::pipeline::GeometryArgs;
+use scene::text::{parse_side, parse_size};
 
 /// Arguments of `bnsview bench`. The ISA comes from the global `--isa` (`all` = every
 /// backend this CPU supports).
@@ -85,19 +85,6 @@ pub struct BenchArgs {
     /// flag to merge runs; a later file's record of the same measurement wins).
     #[arg(long, value_name = "FILE", conflicts_with = "json")]
     pub report: Vec<PathBuf>,
-}
-
-/// Parses `N` (N×N) or `WxH`.
-fn parse_side(s: &str) -> Result<(u32, u32), String> {
-    if s.contains(['x', 'X']) {
-        return parse_size(s);
-    }
-    match s.trim().parse::<u32>() {
-        Ok(n) if n > 0 => Ok((n, n)),
-        _ => Err(format!(
-            "{s:?}: expected a positive edge length N or WIDTHxHEIGHT"
-        )),
-    }
 }
 
 impl BenchArgs {

@@ -14,7 +14,7 @@ pub struct InfoArgs {
     #[arg(long, default_value_t = 4.0)]
     pub voxels_per_angstrom: f32,
     /// Image size of the memory estimate, WIDTHxHEIGHT pixels (as `render --size`).
-    #[arg(long, default_value = "1024x1024", value_parser = crate::look::parse_size)]
+    #[arg(long, default_value = "1024x1024", value_parser = scene::text::parse_size)]
     pub size: (u32, u32),
     /// Machine-readable output.
     #[arg(long)]

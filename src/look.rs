@@ -8,48 +8,9 @@ use render::{Camera, Look, Material, Mode, SecondaryTraversal};
 use scene::{CameraChoice, Orbit, ViewPreset};
 use volume::{Light, TransferFunction};
 
+use scene::text::{non_negative, parse_dir, parse_point, parse_rgb, parse_size, positive};
+
 use crate::pipeline::{GeometryArgs, VolumeArgs};
-
-/// Three finite numbers `x,y,z`.
-fn vec3(s: &str) -> Option<[f32; 3]> {
-    let v: Vec<Option<f32>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
-    match v.as_slice() {
-        [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|a| a.is_finite()) => {
-            Some([*x, *y, *z])
-        }
-        _ => None,
-    }
-}
-
-/// Parses a direction `x,y,z` (not zero).
-fn parse_dir(s: &str) -> Result<[f32; 3], String> {
-    vec3(s)
-        .filter(|v| v.iter().any(|c| *c != 0.0))
-        .ok_or_else(|| format!("{s:?}: expected a non-zero direction x,y,z"))
-}
-
-/// Parses a positive finite number.
-fn positive(s: &str) -> Result<f32, String> {
-    s.trim()
-        .parse::<f32>()
-        .ok()
-        .filter(|v| *v > 0.0 && v.is_finite())
-        .ok_or_else(|| format!("{s:?}: expected a positive number"))
-}
-
-/// Parses a finite number ≥ 0.
-fn non_negative(s: &str) -> Result<f32, String> {
-    s.trim()
-        .parse::<f32>()
-        .ok()
-        .filter(|v| *v >= 0.0 && v.is_finite())
-        .ok_or_else(|| format!("{s:?}: expected a number ≥ 0"))
-}
-
-/// Parses a point `x,y,z` (Å).
-fn parse_point(s: &str) -> Result<[f32; 3], String> {
-    vec3(s).ok_or_else(|| format!("{s:?}: expected a point x,y,z in Å (three finite numbers)"))
-}
 
 /// What a frame shows and how (the flags `render` and `view` share).
 #[derive(Args, Debug, Clone)]
@@ -257,25 +218,5 @@ impl LookArgs {
         }
         orbit.zoom = self.zoom;
         (view, orbit)
-    }
-}
-
-/// Parses `WIDTHxHEIGHT`.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 1024x1024"))?;
-    let p = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
-    match (p(w), p(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
-        _ => Err(format!("{s:?}: width and height must be positive integers")),
-    }
-}
-
-fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
-    let v: Vec<Option<u8>> = s.split(',').map(|c| c.trim().parse().ok()).collect();
-    match v.as_slice() {
-        [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b]),
-        _ => Err(format!("{s:?}: expected r,g,b with each 0-255")),
     }
 }

@@ -3,6 +3,7 @@
 
 use clap::Args;
 use render::{Colormap, Style};
+use scene::text::parse_range;
 use scene::{ColorBy, ModelSettings, RadiusKind, VolumeSettings};
 use volume::VolumeFormat;
 
@@ -40,21 +41,6 @@ pub struct GeometryArgs {
     /// Draw the simulation cell (box) of the input as thin grey sticks.
     #[arg(long)]
     pub cell: bool,
-}
-
-/// `LO:HI`, two finite numbers with LO < HI.
-fn parse_range(s: &str) -> Result<(f32, f32), String> {
-    let bad = || format!("expected LO:HI, two finite numbers with LO < HI (e.g. -1:1), got {s:?}");
-    let (lo, hi) = s.split_once(':').ok_or_else(bad)?;
-    let (lo, hi): (f32, f32) = (
-        lo.trim().parse().map_err(|_| bad())?,
-        hi.trim().parse().map_err(|_| bad())?,
-    );
-    if lo.is_finite() && hi.is_finite() && lo < hi {
-        Ok((lo, hi))
-    } else {
-        Err(bad())
-    }
 }
 
 /// Volume options (the density grid).

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use render::{render_scene, Framebuffer};
+use render::render_scene_to_file;
 use scene::Scene;
 use spmd::Isa;
 
@@ -91,10 +91,9 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         None => PathBuf::from(format!("{}.png", input.input()?.stem())),
     };
     render::ImageFormat::for_output(&output, args.force)?;
-    // Check the frame fits before the expensive preprocessing.
+    // Check the frame (or its band, when streamed) fits before the expensive preprocessing.
     let (w, h) = args.look.size;
-    let probe = Framebuffer::new(w, h, 0).context("allocating the frame")?;
-    drop(probe);
+    render::check_frame((w, h), &output, args.look.geometry.legend)?;
     let l = input.load(false, false)?;
     let m = &l.molecule;
     if m.is_empty() {
@@ -131,9 +130,19 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
     // BENCHMARKS.md, "Progress bands"), so only when a bar can be seen.
     let mut on_rows = |done: u32, _: u32| pb.set_position(done as u64);
     let on_rows = std::io::stderr().is_terminal().then_some(&mut on_rows as _);
-    let image = render_scene(&sc, &camera, &settings, (w, h), legend_ink, isa, on_rows)?;
+    let (stats, legend) = render_scene_to_file(
+        &sc,
+        &camera,
+        &settings,
+        (w, h),
+        legend_ink,
+        isa,
+        on_rows,
+        &output,
+    )
+    .with_context(|| format!("rendering {}", output.display()))?;
     pb.finish_and_clear();
-    if let Some((legend, drawn)) = &image.legend {
+    if let Some((legend, drawn)) = &legend {
         verbose(legend.describe());
         if legend_ink.is_some() && !drawn {
             eprintln!(
@@ -143,11 +152,13 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         }
     }
     let mode = args.look.mode.name();
-    verbose(image.stats.describe(&settings, (w, h), mode));
-    image
-        .frame
-        .save(&output)
-        .with_context(|| format!("writing {}", output.display()))?;
+    verbose(stats.describe(&settings, (w, h), mode));
+    if render::is_streamed((w, h)) {
+        verbose(format!(
+            "stream:  {} rows a band, one in memory",
+            render::band_rows(w)
+        ));
+    }
     eprintln!(
         "wrote {} ({w}x{h}, {}{}, {isa})",
         output.display(),

@@ -4,6 +4,7 @@
 //! band of rows.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -135,10 +136,13 @@ pub fn render_tiles(
 }
 
 /// Rows `rows` of a `width × height` frame into `band` (`rows.len() × width` packed pixels,
-/// row major): bit for bit those rows of [`render_frame`].
+/// row major), only the tiles of `tiles` (the other pixels are left as they are): bit for bit
+/// those pixels of [`render_frame`]. A band of a giant frame, or a rank's share of it.
+#[allow(clippy::too_many_arguments)]
 pub fn render_rows(
     inp: &FrameInputs,
     set: &RenderSettings,
+    tiles: TileSet,
     width: u32,
     height: u32,
     rows: Range<u32>,
@@ -148,7 +152,7 @@ pub fn render_rows(
     let (w, h) = (width as usize, height as usize);
     let rows = rows.start.min(height) as usize..rows.end.min(height) as usize;
     assert_eq!(band.len(), rows.len() * w, "band size");
-    render_rows_of(inp, set, TileSet::All, w, h, rows, band, isa)
+    render_rows_of(inp, set, tiles, w, h, rows, band, isa)
 }
 
 /// Adds `spp` more samples per pixel into `acc` (progressive: sample numbers continue from
@@ -260,7 +264,7 @@ fn drive<P: Send>(
             m.wide();
         }
     }
-    let mut npx = 0u64;
+    let npx = AtomicU64::new(0);
     if w > 0 && h > 0 && spp > 0 && !rows.is_empty() {
         // Bands of rows within one tile row each.
         let mut bands = Vec::new();
@@ -273,7 +277,6 @@ fn drive<P: Send>(
             rest = tail;
             y = end;
         }
-        npx = (rows.len() * w) as u64;
         bands.into_par_iter().for_each(|(y0, y1, band)| {
             let ty = y0 / TILE;
             // Each tile is a rayon task rendering into its own buffer, then copied into the
@@ -299,6 +302,7 @@ fn drive<P: Send>(
             for (tx, out) in &outs {
                 let x0 = tx * TILE;
                 let cols = TILE.min(w - x0);
+                npx.fetch_add(((y1 - y0) * cols) as u64, Relaxed);
                 for y in y0..y1 {
                     let o = ((y - y0) * w + x0) * per_px;
                     put(out, y - ty * TILE, cols, &mut band[o..o + cols * per_px]);
@@ -309,6 +313,6 @@ fn drive<P: Send>(
     RenderStats {
         isa,
         time: start.elapsed(),
-        rays: npx * spp as u64,
+        rays: npx.into_inner() * spp as u64,
     }
 }

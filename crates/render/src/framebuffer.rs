@@ -17,7 +17,10 @@ pub enum RenderError {
     #[error("{0}: unknown image format; name the output .png or .jpg")]
     UnknownFormat(String),
     /// The frame is too large for the PNG encoder or for memory.
-    #[error("framebuffer {0}x{1} is too large")]
+    #[error(
+        "a {0}x{1} frame needs {mib} MiB, more than can be allocated: make it smaller with --size",
+        mib = (u64::from(*.0) * u64::from(*.1) * 4) >> 20
+    )]
     TooLarge(u32, u32),
     /// The output exists and overwriting was not asked for.
     #[error("{0} exists; pass --force to overwrite it")]
@@ -29,6 +32,14 @@ pub enum RenderError {
         path: String,
         /// Its missing directory.
         dir: String,
+    },
+    /// A frame too large to hold whole cannot be made as asked.
+    #[error("a {}x{} frame is streamed to its file in bands of rows (over {} MiB whole), so {reason}", size.0, size.1, crate::STREAM_ABOVE_BYTES >> 20)]
+    Streamed {
+        /// The frame size (pixels).
+        size: (u32, u32),
+        /// What cannot be done, and the way out.
+        reason: String,
     },
     /// The render settings are refused (see [`crate::SettingsError`]).
     #[error(transparent)]
@@ -116,11 +127,7 @@ impl Framebuffer {
 
     /// The pixels as R, G, B, A bytes (no copy on little-endian machines).
     pub fn as_bytes(&self) -> std::borrow::Cow<'_, [u8]> {
-        if cfg!(target_endian = "little") {
-            std::borrow::Cow::Borrowed(bytemuck::cast_slice(&self.pixels))
-        } else {
-            std::borrow::Cow::Owned(self.pixels.iter().flat_map(|p| p.to_le_bytes()).collect())
-        }
+        crate::streamed::rgba_bytes(&self.pixels)
     }
 
     /// Writes the frame in the format of `path`'s extension ([`ImageFormat::from_path`]).

@@ -20,6 +20,7 @@ mod progress;
 mod rng;
 mod scene_image;
 mod settings;
+mod streamed;
 
 pub use accum::Accum;
 pub use ao_at::ambient_occlusion_at;
@@ -34,9 +35,15 @@ pub use progress::{render_frame_with_progress, PROGRESS_BANDS};
 pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };
-pub use scene_image::{render_scene, SceneImage};
+pub use scene_image::{
+    check_frame, draw_scene_legend, render_scene, render_scene_to_file, SceneImage,
+};
 pub use settings::{
     Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,
     DIRECT_AMBIENT, HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP, WHITE_BACKGROUND,
+};
+pub use streamed::{
+    band_buffer, band_rows, bands, is_streamed, render_png_streamed, PngStream, BAND_BYTES,
+    STREAM_ABOVE_BYTES,
 };
 pub use volume::Light;

@@ -3,7 +3,7 @@
 
 use spmd::Isa;
 
-use crate::driver::{render_rows, FrameInputs, RenderStats, TILE};
+use crate::driver::{render_rows, FrameInputs, RenderStats, TileSet, TILE};
 use crate::{Framebuffer, RenderSettings, SettingsError};
 
 #[cfg(doc)]
@@ -34,7 +34,7 @@ pub fn render_frame_with_progress(
     while start < h {
         let end = (start + band).min(h);
         let pixels = &mut fb.pixels[(start * w) as usize..(end * w) as usize];
-        let s = render_rows(inp, set, w, h, start..end, pixels, isa)?;
+        let s = render_rows(inp, set, TileSet::All, w, h, start..end, pixels, isa)?;
         stats.time += s.time;
         stats.rays += s.rays;
         on_rows(end, h);

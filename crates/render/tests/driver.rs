@@ -1,11 +1,15 @@
 //! The driver's partial renders against the whole frame, bit for bit: the union of every rank's
 //! interleaved tiles and of row bands is the frame that one call renders, and a path-traced
-//! frame is its accumulation (what MPI ranks, giant-frame bands and the viewer rely on).
+//! frame is its accumulation (what MPI ranks, giant-frame bands and the viewer rely on); a
+//! frame streamed band by band into a PNG decodes to the frame rendered whole.
 
 use molecule::scenes::{generate, SceneName};
+use std::path::PathBuf;
+
 use render::{
-    accumulate, render_frame, render_frame_with_progress, render_rows, render_tiles, Accum, Camera,
-    FrameInputs, Framebuffer, Material, Modality, RenderSettings, TileSet, View, DARK_BACKGROUND,
+    accumulate, band_rows, render_frame, render_frame_with_progress, render_png_streamed,
+    render_rows, render_tiles, Accum, Camera, FrameInputs, Framebuffer, Material, Modality,
+    PngStream, RenderSettings, TileSet, View, DARK_BACKGROUND,
 };
 use scene::{Scene, SceneSettings, VolumeSettings};
 use spmd::Isa;
@@ -152,7 +156,7 @@ fn row_bands_together_are_the_whole_frame() {
             let mut rows = Vec::new();
             for (a, b) in [(0, 5), (5, 6), (6, 20), (20, H)] {
                 let mut band = vec![0u32; ((b - a) * W) as usize];
-                render_rows(&inp, &set, W, H, a..b, &mut band, isa).unwrap();
+                render_rows(&inp, &set, TileSet::All, W, H, a..b, &mut band, isa).unwrap();
                 rows.extend(band);
             }
             assert!(
@@ -193,4 +197,118 @@ fn a_whole_path_traced_frame_is_its_accumulation_tone_mapped() {
             assert!(fb == acc.to_framebuffer(true, set.exposure), "{isa} {name}");
         }
     }
+}
+
+/// A fresh directory for this test's files.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bns-render-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&d).ok();
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The RGBA bytes of a PNG, decoded by the `image` crate.
+fn decode(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
+    let im = image::open(path).unwrap().into_rgba8();
+    (im.width(), im.height(), im.into_raw())
+}
+
+#[test]
+fn a_frame_streamed_in_bands_decodes_to_the_frame_rendered_whole() {
+    let dir = temp_dir("streamed");
+    let sc = scene();
+    let model = sc.model.as_ref().unwrap();
+    let (w, h) = (203, 150); // partial tiles at both edges; bands of 32 rows: five bands
+    let cam = Camera::view(
+        View::Far,
+        sc.sphere.center,
+        sc.sphere.radius,
+        45.0,
+        203.0 / 150.0,
+    );
+    for isa in Isa::under_test() {
+        for (name, set, vol) in settings() {
+            let vs = sc.volume_scene(set.march).filter(|_| vol);
+            let inp = FrameInputs {
+                model: Some(model),
+                volume: vs.as_ref(),
+                camera: &cam,
+            };
+            let mut whole = Framebuffer::new(w, h, 0).unwrap();
+            render_frame(&inp, &set, &mut whole, isa).unwrap();
+            let path = dir.join(format!("{name}-{isa}.png"));
+            let mut done = Vec::new();
+            let stats =
+                render_png_streamed(&inp, &set, (w, h), 32, &path, isa, &mut |d, _| done.push(d))
+                    .unwrap();
+            assert_eq!(done, [32, 64, 96, 128, 150], "{isa} {name}");
+            assert_eq!(
+                stats.rays,
+                u64::from(w * h * set.frame_samples()),
+                "{isa} {name}"
+            );
+            let (dw, dh, bytes) = decode(&path);
+            assert!(
+                (dw, dh) == (w, h) && bytes == *whole.as_bytes(),
+                "{isa} {name}: the streamed PNG differs from the frame rendered whole"
+            );
+        }
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn a_4096_square_frame_streamed_in_bands_is_the_frame_rendered_whole() {
+    let dir = temp_dir("streamed4096");
+    let sc = scene();
+    let (w, h) = (4096, 4096);
+    let cam = Camera::view(View::Close, sc.sphere.center, sc.sphere.radius, 45.0, 1.0);
+    let inp = FrameInputs::geometry(sc.model.as_ref().unwrap(), &cam);
+    let set = RenderSettings::default();
+    let isa = Isa::detect();
+    let mut whole = Framebuffer::new(w, h, 0).unwrap();
+    render_frame(&inp, &set, &mut whole, isa).unwrap();
+    // The band a frame this wide gets (4,096 rows: one band) and eight of 512 rows.
+    assert_eq!(band_rows(w), 4096);
+    for rows in [band_rows(w), 512] {
+        let path = dir.join(format!("bands-{rows}.png"));
+        render_png_streamed(&inp, &set, (w, h), rows, &path, isa, &mut |_, _| {}).unwrap();
+        let (dw, dh, bytes) = decode(&path);
+        assert!(
+            (dw, dh) == (w, h) && bytes == *whole.as_bytes(),
+            "bands of {rows} rows"
+        );
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn a_stream_dropped_unfinished_leaves_the_old_file_and_no_partial_one() {
+    let dir = temp_dir("unfinished");
+    let path = dir.join("frame.png");
+    std::fs::write(&path, b"the user's old image").unwrap();
+    let mut png = PngStream::create(&path, (16, 4)).unwrap();
+    png.write_rows(&[0xff00_00ff; 32]).unwrap();
+    assert_eq!(png.rows(), 2);
+    drop(png); // a band failed: two rows of four written
+    assert_eq!(std::fs::read(&path).unwrap(), b"the user's old image");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["frame.png"], "only the old file is left");
+    // Finished, it replaces the file.
+    let mut png = PngStream::create(&path, (16, 4)).unwrap();
+    png.write_rows(&[0xff00_00ff; 64]).unwrap();
+    png.finish().unwrap();
+    let (w, h, bytes) = decode(&path);
+    assert!((w, h) == (16, 4) && bytes.chunks(4).all(|p| p == [255, 0, 0, 255]));
+    // A directory that is not there: the error names the file.
+    let missing = dir.join("no-such-dir").join("frame.png");
+    let err = PngStream::create(&missing, (16, 4))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("no-such-dir/frame.png"), "{err}");
+    std::fs::remove_dir_all(dir).ok();
 }

@@ -14,12 +14,14 @@ mod colormap;
 mod describe;
 mod error;
 mod fit;
+mod frame_bands;
 mod input;
 mod memory;
 mod model;
 mod periodic;
 mod report;
 mod settings;
+pub mod text;
 
 pub use build::{DensityVolume, Prepared, Progress, Scene, Stage, Timings, UnwrapReport};
 pub use camera::{Camera, Projection, View};
@@ -29,6 +31,9 @@ pub use describe::{Description, EstimateFor};
 pub use error::SceneError;
 pub use fit::{
     ball_sphere, bounding_sphere, CameraChoice, Orbit, Sphere, ViewPreset, ATOM_SPHERE_PAD,
+};
+pub use frame_bands::{
+    band_rows, held_frame_bytes, is_streamed, BAND_BYTES, BAND_ROW_MULTIPLE, STREAM_ABOVE_BYTES,
 };
 pub use input::{Input, LoadedFrame};
 pub use memory::{

@@ -60,7 +60,8 @@ pub struct MemoryEstimate {
     /// Per-atom scratch the scene keeps between frames: radius (4 B) and colour (4 B) with a
     /// model, the density radii (4 B) for a volume alone.
     pub scratch: u64,
-    /// Frame: packed RGBA8 pixels, 4 B per pixel.
+    /// Frame: packed RGBA8 pixels, 4 B per pixel, of the whole frame or, when it is streamed,
+    /// of one band ([`crate::held_frame_bytes`]).
     pub framebuffer: u64,
     /// Lattice points of the density volume along x, y, z (`None`: no volume).
     pub volume_dims: Option<[usize; 3]>,
@@ -121,8 +122,8 @@ impl MemoryEstimate {
                     .product();
             }
         }
-        if let Some((w, h)) = settings.frame {
-            e.framebuffer = w as u64 * h as u64 * FRAME_BYTES_PER_PIXEL;
+        if let Some(size) = settings.frame {
+            e.framebuffer = crate::held_frame_bytes(size);
         }
         e.scratch = scratch_bytes(m.len(), settings);
         e.peak = Peak::new(&e, &counts);
@@ -154,8 +155,8 @@ impl MemoryEstimate {
         if let Some(lv) = &scene.light_volume {
             e.light_volume = lv.bytes();
         }
-        if let Some((w, h)) = scene.settings.frame {
-            e.framebuffer = w as u64 * h as u64 * FRAME_BYTES_PER_PIXEL;
+        if let Some(size) = scene.settings.frame {
+            e.framebuffer = crate::held_frame_bytes(size);
         }
         e.scratch = scene.scratch_bytes();
         e

@@ -129,9 +129,10 @@ pub struct LookArgs {
 }
 
 impl LookArgs {
-    /// Sets the size of rayon's global pool from `--threads` (refused beyond 16 per core).
-    pub fn init_threads(&self) -> Result<()> {
-        if let Some(n) = self.threads {
+    /// Sets the size of rayon's global pool from `--threads` (refused beyond 16 per core),
+    /// else to `default` when given (an MPI rank's share of the cores).
+    pub fn init_threads(&self, default: Option<usize>) -> Result<()> {
+        if let Some(n) = self.threads.or(default) {
             // More threads than this per core only add overhead (and a stack each).
             let cap = 16 * std::thread::available_parallelism().map_or(1, |c| c.get());
             if n == 0 || n > cap {

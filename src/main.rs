@@ -68,13 +68,29 @@ fn parse_isa_arg(s: &str) -> Result<IsaArg, spmd::IsaError> {
 }
 
 fn main() {
-    if let Err(e) = run(Cli::parse()) {
-        eprintln!("error: {e:#}");
+    let cli = Cli::parse();
+    let result = cluster::Ranks::from_launch()
+        .map_err(anyhow::Error::from)
+        .and_then(|ranks| {
+            let result = run(cli, ranks.as_ref());
+            // Under mpirun, every rank ends with the first failing rank's error (MPI finalised
+            // when `ranks` drops).
+            match ranks {
+                Some(r) => r.settle(result.map_err(|e| format!("{e:#}"))),
+                None => result.map_err(|e| format!("{e:#}")),
+            }
+            .map_err(anyhow::Error::msg)
+        });
+    if let Err(e) = result {
+        // Under mpirun, rank 0 speaks for the job.
+        if cluster::Launch::from_env().is_none_or(|l| l.rank == 0) {
+            eprintln!("error: {e:#}");
+        }
         std::process::exit(1);
     }
 }
 
-fn run(cli: Cli) -> Result<()> {
+fn run(cli: Cli, ranks: Option<&cluster::Ranks>) -> Result<()> {
     let requested = match cli.isa {
         Some(IsaArg::One(i)) => Some(i),
         Some(IsaArg::All) if !matches!(cli.command, Some(Command::Bench(_))) => {
@@ -91,13 +107,16 @@ fn run(cli: Cli) -> Result<()> {
         );
         return Ok(());
     }
+    if let Some(r) = ranks.filter(|_| !matches!(cli.command, Some(Command::Render(_)))) {
+        anyhow::bail!("under mpirun ({} ranks) only `bnsview render` is shared out; run this command as one process", r.size());
+    }
     match cli.command {
         Some(Command::Isa) => {
             print!("{}", Isa::table(isa));
             Ok(())
         }
         Some(Command::Info(args)) => info::run(args),
-        Some(Command::Render(args)) => render_cmd::run(*args, isa),
+        Some(Command::Render(args)) => render_cmd::run(*args, isa, ranks),
         Some(Command::View(args)) => view_cmd::run(*args, isa),
         Some(Command::Generate(args)) => generate::run(args),
         Some(Command::Bench(args)) => {

@@ -3,8 +3,9 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
+use cluster::Ranks;
 use render::render_scene_to_file;
 use scene::Scene;
 use spmd::Isa;
@@ -78,19 +79,27 @@ pub struct RenderArgs {
 }
 
 /// Run `bnsview render`.
-pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
-    args.look.init_threads()?;
+/// `ranks`: the MPI job this process is a rank of (the frame's tiles are shared out, rank 0
+/// writes and reports).
+pub fn run(args: RenderArgs, isa: Isa, ranks: Option<&Ranks>) -> Result<()> {
+    args.look.init_threads(ranks.map(Ranks::default_threads))?;
+    let root = ranks.is_none_or(|r| r.rank() == 0);
     let look = args.look.look(args.input.pbc)?;
     look.validate()?;
     let input = &args.input;
     if args.frames.is_some() || args.follow {
+        if let Some(r) = ranks {
+            bail!("--frames and --follow run as one process; under mpirun ({} ranks) only one frame is shared out", r.size());
+        }
         return crate::series_cmd::run(&args, &look, input, isa);
     }
     let output = match &args.output {
         Some(o) => o.clone(),
         None => PathBuf::from(format!("{}.png", input.input()?.stem())),
     };
-    render::ImageFormat::for_output(&output, args.force)?;
+    if root {
+        render::ImageFormat::for_output(&output, args.force)?;
+    }
     // Check the frame (or its band, when streamed) fits before the expensive preprocessing.
     let (w, h) = args.look.size;
     render::check_frame((w, h), &output, args.look.geometry.legend)?;
@@ -100,7 +109,7 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         bail!("{}: no atoms to render", l.source);
     }
     let verbose = |msg: String| {
-        if args.look.verbose {
+        if args.look.verbose && root {
             eprintln!("{msg}");
         }
     };
@@ -125,26 +134,32 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
         &format!("rendering {w}x{h} {}", args.look.mode.name()),
         h as u64,
     );
-    let legend_ink = args.look.geometry.legend.then(|| look.legend_ink());
+    let ink = args.look.geometry.legend.then(|| look.legend_ink());
     // Bands cost up to ~10-20 % on a 50-150 ms frame (threads idle at each band's end:
     // BENCHMARKS.md, "Progress bands"), so only when a bar can be seen.
     let mut on_rows = |done: u32, _: u32| pb.set_position(done as u64);
     let on_rows = std::io::stderr().is_terminal().then_some(&mut on_rows as _);
-    let (stats, legend) = render_scene_to_file(
-        &sc,
-        &camera,
-        &settings,
-        (w, h),
-        legend_ink,
-        isa,
-        on_rows,
-        &output,
-    )
-    .with_context(|| format!("rendering {}", output.display()))?;
+    let (stats, legend) = match ranks {
+        None => render_scene_to_file(&sc, &camera, &settings, (w, h), ink, isa, on_rows, &output)?,
+        Some(r) => {
+            let f = r.render_scene_to_file(
+                &sc,
+                &camera,
+                &settings,
+                (w, h),
+                ink,
+                isa,
+                on_rows,
+                &output,
+            )?;
+            f.describe().into_iter().for_each(verbose);
+            (f.stats, f.legend)
+        }
+    };
     pb.finish_and_clear();
     if let Some((legend, drawn)) = &legend {
         verbose(legend.describe());
-        if legend_ink.is_some() && !drawn {
+        if ink.is_some() && !drawn {
             eprintln!(
                 "warning: --legend: the image is too small for a legend (under {} pixels on a side)",
                 render::MIN_LEGEND_FRAME
@@ -159,11 +174,9 @@ pub fn run(args: RenderArgs, isa: Isa) -> Result<()> {
             render::band_rows(w)
         ));
     }
-    eprintln!(
-        "wrote {} ({w}x{h}, {}{}, {isa})",
-        output.display(),
-        args.look.mode.name(),
-        settings.describe()
-    );
+    if root {
+        let (out, more) = (output.display(), settings.describe());
+        eprintln!("wrote {out} ({w}x{h}, {mode}{more}, {isa})");
+    }
     Ok(())
 }

@@ -39,7 +39,7 @@ pub struct ViewArgs {
 
 /// Run `bnsview view`.
 pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
-    args.look.init_threads()?;
+    args.look.init_threads(None)?;
     let look = args.look.look(args.input.pbc)?;
     look.validate()?;
     if args.look.geometry.legend {

@@ -61,7 +61,9 @@ pub enum TileSet<'a> {
 }
 
 impl TileSet<'_> {
-    fn owns(&self, tx: usize, ty: usize, across: usize) -> bool {
+    /// Whether tile `(tx, ty)` (in tiles from the top left) of a frame `across` tiles wide is
+    /// in the set.
+    pub fn owns(&self, tx: usize, ty: usize, across: usize) -> bool {
         match *self {
             TileSet::All => true,
             TileSet::Interleaved { rank, ranks } => (tx + ty * across) % ranks.max(1) == rank,

@@ -1,0 +1,255 @@
+//! One frame rendered by every rank (the paper's image-parallel renderer): the tiles of each
+//! band dealt round robin, rendered by each rank's threads, gathered by rank 0 into the frame
+//! or into the streamed PNG of a giant frame.
+
+use std::ops::Range;
+use std::path::Path;
+use std::time::Instant;
+
+use mpi::datatype::PartitionMut;
+use mpi::traits::*;
+use mpi::Count;
+use render::{
+    band_buffer, band_rows, bands, draw_scene_legend, is_streamed, render_rows, Camera,
+    FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderSettings, RenderStats, TileSet,
+};
+use scene::Scene;
+use spmd::Isa;
+
+use crate::{owned_tiles, pack, segments, unpack, ClusterError, ClusterFrame, RankStats, Ranks};
+
+/// Where a rank's band of pixels lives.
+enum Out {
+    /// Rank 0 of a frame held whole: bands are rows of the frame.
+    Whole(Framebuffer),
+    /// Rank 0 of a giant frame: the band, then into the PNG.
+    Streamed(Box<PngStream>, Vec<u32>),
+    /// Any other rank: its band, whose tiles are sent to rank 0.
+    Worker(Vec<u32>),
+}
+
+/// A rank's buffers for one frame, allocated before the ranks agree to render.
+struct Buffers {
+    out: Out,
+    /// Rank 0: the other ranks' pixels of a band.
+    recv: Vec<u32>,
+}
+
+impl Buffers {
+    fn new(
+        root: bool,
+        path: &Path,
+        (w, h): (u32, u32),
+        rows_per_band: u32,
+        background: u32,
+    ) -> Result<Buffers, RenderError> {
+        let band = || band_buffer(w, rows_per_band.min(h));
+        let out = match (root, is_streamed((w, h))) {
+            (false, _) => Out::Worker(band()?),
+            (true, false) => Out::Whole(Framebuffer::new(w, h, background)?),
+            (true, true) => Out::Streamed(Box::new(PngStream::create(path, (w, h))?), band()?),
+        };
+        let recv = if root { band()? } else { Vec::new() };
+        Ok(Buffers { out, recv })
+    }
+
+    /// The pixels of band `rows` of a frame `w` wide, and rank 0's receive buffer.
+    fn band(&mut self, rows: &Range<u32>, w: u32) -> (&mut [u32], &mut [u32]) {
+        let (a, b) = (
+            rows.start as usize * w as usize,
+            rows.end as usize * w as usize,
+        );
+        let px = match &mut self.out {
+            Out::Whole(fb) => &mut fb.pixels[a..b],
+            Out::Streamed(_, band) | Out::Worker(band) => &mut band[..b - a],
+        };
+        (px, &mut self.recv)
+    }
+
+    /// Rank 0: the finished band `rows` into the PNG of a giant frame.
+    fn write(&mut self, rows: &Range<u32>, w: u32) -> Result<(), RenderError> {
+        match &mut self.out {
+            Out::Streamed(png, band) => png.write_rows(&band[..rows.len() * w as usize]),
+            _ => Ok(()),
+        }
+    }
+
+    /// Rank 0: the legend drawn and the frame saved, or the PNG finished.
+    fn finish(
+        self,
+        scene: &Scene,
+        legend_ink: Option<[u8; 3]>,
+        path: &Path,
+    ) -> Result<Option<(Legend, bool)>, RenderError> {
+        match self.out {
+            Out::Whole(mut fb) => {
+                let legend = draw_scene_legend(scene, &mut fb, legend_ink);
+                fb.save(path)?;
+                Ok(legend)
+            }
+            Out::Streamed(png, _) => png.finish().map(|()| None),
+            Out::Worker(_) => Ok(None),
+        }
+    }
+}
+
+impl RankStats {
+    /// As four numbers for one message: tiles, rays, render and wall time in nanoseconds.
+    fn to_words(self) -> [u64; 4] {
+        let ns = |s: f64| (s * 1e9) as u64;
+        [self.tiles, self.rays, ns(self.render_s), ns(self.wall_s)]
+    }
+
+    /// The inverse of [`RankStats::to_words`].
+    fn from_words(w: &[u64]) -> RankStats {
+        RankStats {
+            tiles: w[0],
+            rays: w[1],
+            render_s: w[2] as f64 * 1e-9,
+            wall_s: w[3] as f64 * 1e-9,
+        }
+    }
+}
+
+impl Ranks {
+    /// Renders `scene` into the image file `path` with every rank (collective: every rank
+    /// calls it with the same scene, camera, settings and size): as
+    /// `render::render_scene_to_file`, pixel for pixel, with the tiles of each band dealt to
+    /// the ranks round robin and rank 0 gathering and writing. A frame over
+    /// `render::STREAM_ABOVE_BYTES` is streamed in bands. `on_rows` (rank 0) is told the rows
+    /// written. Returns on rank 0 what every rank did.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_scene_to_file(
+        &self,
+        scene: &Scene,
+        camera: &Camera,
+        settings: &RenderSettings,
+        (w, h): (u32, u32),
+        legend_ink: Option<[u8; 3]>,
+        isa: Isa,
+        mut on_rows: Option<&mut dyn FnMut(u32, u32)>,
+        path: &Path,
+    ) -> Result<ClusterFrame, ClusterError> {
+        let (rank, ranks) = (self.rank(), self.size());
+        let tiles = TileSet::Interleaved { rank, ranks };
+        let vscene = scene.volume_scene(settings.march);
+        let inp = FrameInputs {
+            model: scene.model.as_ref(),
+            volume: vscene.as_ref(),
+            camera,
+        };
+        let rows_per_band = if is_streamed((w, h)) { band_rows(w) } else { h };
+        // All that can fail on one rank but not the others, before the ranks agree.
+        let ready = settings
+            .validate(inp.model.is_some(), inp.volume.is_some())
+            .map_err(RenderError::from)
+            .and_then(|()| {
+                let bg = settings.background_packed();
+                Buffers::new(rank == 0, path, (w, h), rows_per_band, bg)
+            });
+        let mut buf = self.agree(ready.map_err(|e| e.to_string()))?;
+        let root = self.world.process_at_rank(0);
+        let start = Instant::now();
+        let mut mine = RankStats::default();
+        // Rank 0's last write; the others learn of it at the next band.
+        let mut written: Result<(), RenderError> = Ok(());
+        for rows in bands(h, rows_per_band) {
+            let (px, recv) = buf.band(&rows, w);
+            let t = Instant::now();
+            let s = render_rows(&inp, settings, tiles, w, h, rows.clone(), px, isa)
+                .expect("the settings were validated before the ranks agreed");
+            mine.render_s += t.elapsed().as_secs_f64();
+            mine.rays += s.rays;
+            mine.tiles += owned_tiles(w, rows.clone(), &tiles) as u64;
+            if rank == 0 {
+                self.gather_band(px, recv, w, &rows);
+            } else {
+                root.gather_varcount_into(&pack(px, w, rows.clone(), &tiles)[..]);
+            }
+            self.go_on(&written)?;
+            if rank == 0 {
+                written = buf.write(&rows, w);
+                if let Some(f) = on_rows.as_mut() {
+                    f(rows.end, h);
+                }
+            }
+        }
+        mine.wall_s = start.elapsed().as_secs_f64();
+        let mut legend = None;
+        if rank == 0 {
+            written =
+                written.and_then(|()| buf.finish(scene, legend_ink, path).map(|l| legend = l));
+        }
+        self.go_on(&written)?;
+        let words = mine.to_words();
+        if rank != 0 {
+            root.gather_into(&words[..]);
+            return Ok(ClusterFrame {
+                stats: RenderStats {
+                    isa,
+                    time: start.elapsed(),
+                    rays: mine.rays,
+                },
+                legend: None,
+                ranks: Vec::new(),
+            });
+        }
+        // The frame's time: its bands rendered, gathered (and streamed), not the file saved.
+        let time = std::time::Duration::from_secs_f64(mine.wall_s);
+        let mut all = vec![0u64; 4 * ranks];
+        root.gather_into_root(&words[..], &mut all[..]);
+        let per_rank: Vec<RankStats> = all.chunks(4).map(RankStats::from_words).collect();
+        Ok(ClusterFrame {
+            stats: RenderStats {
+                isa,
+                time,
+                rays: per_rank.iter().map(|r| r.rays).sum(),
+            },
+            legend,
+            ranks: per_rank,
+        })
+    }
+
+    /// Rank 0: every other rank's tiles of band `rows` received into `recv` and unpacked
+    /// into `px` (rank 0's own tiles are already there).
+    fn gather_band(&self, px: &mut [u32], recv: &mut [u32], w: u32, rows: &Range<u32>) {
+        let ranks = self.size();
+        let share = |r| TileSet::Interleaved { rank: r, ranks };
+        let counts: Vec<Count> = (0..ranks)
+            .map(|r| match r {
+                0 => 0,
+                _ => segments(w, rows.clone(), &share(r))
+                    .map(|s| s.1 as Count)
+                    .sum(),
+            })
+            .collect();
+        let displs: Vec<Count> = counts
+            .iter()
+            .scan(0, |at, &c| Some(std::mem::replace(at, *at + c)))
+            .collect();
+        let total = counts.iter().sum::<Count>() as usize;
+        let mut part = PartitionMut::new(&mut recv[..total], &counts[..], &displs[..]);
+        let root = self.world.process_at_rank(0);
+        root.gather_varcount_into_root(&[0u32; 0][..], &mut part);
+        for r in 1..ranks {
+            let (a, n) = (displs[r] as usize, counts[r] as usize);
+            unpack(&recv[a..a + n], px, w, rows.clone(), &share(r));
+        }
+    }
+
+    /// Collective: rank 0 says whether its last write succeeded; if not, every rank stops
+    /// (rank 0 with its error).
+    fn go_on(&self, written: &Result<(), RenderError>) -> Result<(), ClusterError> {
+        let mut ok = u8::from(written.is_ok());
+        self.world.process_at_rank(0).broadcast_into(&mut ok);
+        match (ok, written) {
+            (1, _) => Ok(()),
+            (_, Err(e)) if self.rank() == 0 => Err(ClusterError::Failed {
+                rank: 0,
+                ranks: self.size(),
+                message: e.to_string(),
+            }),
+            _ => Err(ClusterError::Stopped),
+        }
+    }
+}

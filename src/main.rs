@@ -69,24 +69,32 @@ fn parse_isa_arg(s: &str) -> Result<IsaArg, spmd::IsaError> {
 
 fn main() {
     let cli = Cli::parse();
-    let result = cluster::Ranks::from_launch()
-        .map_err(anyhow::Error::from)
-        .and_then(|ranks| {
-            let result = run(cli, ranks.as_ref());
-            // Under mpirun, every rank ends with the first failing rank's error (MPI finalised
-            // when `ranks` drops).
-            match ranks {
-                Some(r) => r.settle(result.map_err(|e| format!("{e:#}"))),
-                None => result.map_err(|e| format!("{e:#}")),
-            }
-            .map_err(anyhow::Error::msg)
-        });
-    if let Err(e) = result {
-        // Under mpirun, rank 0 speaks for the job.
-        if cluster::Launch::from_env().is_none_or(|l| l.rank == 0) {
-            eprintln!("error: {e:#}");
+    let ok = match cluster::Ranks::from_launch() {
+        // Under mpirun: every rank ends with the first failing rank's error, which rank 0
+        // prints.
+        Ok(Some(ranks)) => {
+            let result = run(cli, Some(&ranks)).map_err(|e| format!("{e:#}"));
+            ranks.conclude(result, |e| eprintln!("error: {e}"))
         }
+        Ok(None) => report(run(cli, None)),
+        Err(e) => report(Err(e.into())),
+    };
+    if !ok {
         std::process::exit(1);
+    }
+}
+
+/// Prints the error of a process that is not an MPI rank; returns whether it succeeded. Copies
+/// launched by mpirun without MPI in the build leave the message to rank 0 and exit quietly
+/// with success, since mpirun would kill rank 0 as soon as one of them failed.
+fn report(result: Result<()>) -> bool {
+    let Err(e) = result else { return true };
+    match cluster::Launch::from_env() {
+        Some(l) if l.rank != 0 => true,
+        _ => {
+            eprintln!("error: {e:#}");
+            false
+        }
     }
 }
 

@@ -10,8 +10,9 @@ use mpi::datatype::PartitionMut;
 use mpi::traits::*;
 use mpi::Count;
 use render::{
-    band_buffer, band_rows, bands, draw_scene_legend, is_streamed, render_rows, Camera,
-    FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderSettings, RenderStats, TileSet,
+    band_buffer, band_rows, bands, draw_scene_legend, is_streamed, render_rows, BandEncoder,
+    Camera, FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderSettings, RenderStats,
+    TileSet,
 };
 use scene::Scene;
 use spmd::Isa;
@@ -22,8 +23,9 @@ use crate::{owned_tiles, pack, segments, unpack, ClusterError, ClusterFrame, Ran
 enum Out {
     /// Rank 0 of a frame held whole: bands are rows of the frame.
     Whole(Framebuffer),
-    /// Rank 0 of a giant frame: the band, then into the PNG.
-    Streamed(Box<PngStream>, Vec<u32>),
+    /// Rank 0 of a giant frame: the band, then to the PNG's encoder thread (which gives back
+    /// the buffer of the band before).
+    Streamed(Box<BandEncoder>, Vec<u32>),
     /// Any other rank: its band, whose tiles are sent to rank 0.
     Worker(Vec<u32>),
 }
@@ -47,7 +49,10 @@ impl Buffers {
         let out = match (root, is_streamed((w, h))) {
             (false, _) => Out::Worker(band()?),
             (true, false) => Out::Whole(Framebuffer::new(w, h, background)?),
-            (true, true) => Out::Streamed(Box::new(PngStream::create(path, (w, h))?), band()?),
+            (true, true) => {
+                let png = PngStream::create(path, (w, h))?;
+                Out::Streamed(Box::new(BandEncoder::spawn(png, band()?)?), band()?)
+            }
         };
         let recv = if root { band()? } else { Vec::new() };
         Ok(Buffers { out, recv })
@@ -68,9 +73,21 @@ impl Buffers {
 
     /// Rank 0: the finished band `rows` into the PNG of a giant frame.
     fn write(&mut self, rows: &Range<u32>, w: u32) -> Result<(), RenderError> {
-        match &mut self.out {
-            Out::Streamed(png, band) => png.write_rows(&band[..rows.len() * w as usize]),
-            _ => Ok(()),
+        let Out::Streamed(png, band) = &mut self.out else {
+            return Ok(());
+        };
+        let len = band.len();
+        match png.write(std::mem::take(band), rows.len() * w as usize) {
+            Ok(next) => {
+                *band = next;
+                Ok(())
+            }
+            Err(e) => {
+                // The buffer went down with the encoder: the ranks still meet at the next
+                // band (rank 0 stops them there), so rank 0 needs one to render into.
+                *band = vec![0; len];
+                Err(e)
+            }
         }
     }
 

@@ -102,4 +102,17 @@ impl Ranks {
         }
         self.agree(result).map_err(|e| e.to_string())
     }
+
+    /// Ends this rank's part in the job with its command's `result`: [`Ranks::settle`]s it,
+    /// lets rank 0 `report` the job's error, then waits for every rank (a barrier) before MPI
+    /// is finalised, because mpirun kills the job as soon as one rank exits with an error
+    /// and rank 0 could be killed before it has said why. Returns whether the job succeeded.
+    pub fn conclude(self, result: Result<(), String>, report: impl FnOnce(&str)) -> bool {
+        let result = self.settle(result);
+        if let (Err(e), 0) = (&result, self.rank()) {
+            report(e);
+        }
+        self.world.barrier();
+        result.is_ok()
+    }
 }

@@ -43,6 +43,11 @@ impl Ranks {
         match self.0 {}
     }
 
+    /// Ends this rank's part in the job (see the `mpi` build).
+    pub fn conclude(self, _result: Result<(), String>, _report: impl FnOnce(&str)) -> bool {
+        match self.0 {}
+    }
+
     /// Renders a frame over the ranks (see the `mpi` build).
     #[allow(clippy::too_many_arguments)]
     pub fn render_scene_to_file(

@@ -10,6 +10,7 @@
 
 mod accum;
 mod ao_at;
+mod band_encoder;
 mod camera_rays;
 mod driver;
 mod framebuffer;
@@ -24,8 +25,10 @@ mod streamed;
 
 pub use accum::Accum;
 pub use ao_at::ambient_occlusion_at;
+pub use band_encoder::BandEncoder;
 pub use driver::{
-    accumulate, render_frame, render_rows, render_tiles, FrameInputs, RenderStats, TileSet, TILE,
+    accumulate, render_frame, render_rows, render_tiles, with_scene_inputs, FrameInputs,
+    RenderStats, TileSet, TILE,
 };
 pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};

@@ -7,7 +7,7 @@ use std::path::Path;
 use scene::Scene;
 use spmd::Isa;
 
-use crate::driver::{render_frame, FrameInputs, RenderStats};
+use crate::driver::{render_frame, with_scene_inputs, RenderStats};
 use crate::framebuffer::{Framebuffer, ImageFormat, RenderError};
 use crate::legend::{draw_legend, Legend};
 use crate::progress::render_frame_with_progress;
@@ -39,17 +39,11 @@ pub fn render_scene(
     isa: Isa,
     on_rows: Option<&mut dyn FnMut(u32, u32)>,
 ) -> Result<SceneImage, RenderError> {
-    let vscene = scene.volume_scene(settings.march);
-    let inputs = FrameInputs {
-        model: scene.model.as_ref(),
-        volume: vscene.as_ref(),
-        camera,
-    };
     let mut frame = Framebuffer::new(size.0, size.1, settings.background_packed())?;
-    let stats = match on_rows {
-        Some(f) => render_frame_with_progress(&inputs, settings, &mut frame, isa, f)?,
-        None => render_frame(&inputs, settings, &mut frame, isa)?,
-    };
+    let stats = with_scene_inputs(scene, camera, settings.march, |inp| match on_rows {
+        Some(f) => render_frame_with_progress(inp, settings, &mut frame, isa, f),
+        None => render_frame(inp, settings, &mut frame, isa),
+    })?;
     let legend = draw_scene_legend(scene, &mut frame, legend_ink);
     Ok(SceneImage {
         frame,
@@ -125,15 +119,11 @@ pub fn render_scene_to_file(
         image.frame.save(path)?;
         return Ok((image.stats, image.legend));
     }
-    let vscene = scene.volume_scene(settings.march);
-    let inputs = FrameInputs {
-        model: scene.model.as_ref(),
-        volume: vscene.as_ref(),
-        camera,
-    };
     let mut none = |_, _| {};
     let on_rows = on_rows.unwrap_or(&mut none);
     let rows = band_rows(size.0);
-    let stats = render_png_streamed(&inputs, settings, size, rows, path, isa, on_rows)?;
+    let stats = with_scene_inputs(scene, camera, settings.march, |inp| {
+        render_png_streamed(inp, settings, size, rows, path, isa, on_rows)
+    })?;
     Ok((stats, None))
 }

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 pub use scene::{band_rows, is_streamed, BAND_BYTES, STREAM_ABOVE_BYTES};
 use spmd::Isa;
 
+use crate::band_encoder::BandEncoder;
 use crate::driver::{render_rows, FrameInputs, RenderStats, TileSet, TILE};
 use crate::framebuffer::RenderError;
 use crate::settings::RenderSettings;
@@ -80,6 +81,11 @@ impl PngStream {
         self.rows
     }
 
+    /// The file's final name.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Ends the PNG (every row must be in) and renames it to its path.
     pub fn finish(mut self) -> Result<(), RenderError> {
         assert_eq!(self.rows, self.size.1, "every row written");
@@ -104,8 +110,8 @@ impl Drop for PngStream {
 }
 
 /// Renders the `size` frame in bands of `rows_per_band` rows (see [`scene::band_rows`]), each
-/// encoded into a [`PngStream`] to `path` as soon as it is rendered; `on_rows` is told the
-/// rows finished. Pixels are bit for bit those of [`crate::render_frame`].
+/// encoded into a [`PngStream`] to `path` by a [`BandEncoder`] while the next band renders;
+/// `on_rows` is told the rows rendered. Pixels are bit for bit those of [`crate::render_frame`].
 pub fn render_png_streamed(
     inp: &FrameInputs,
     set: &RenderSettings,
@@ -116,17 +122,27 @@ pub fn render_png_streamed(
     on_rows: &mut dyn FnMut(u32, u32),
 ) -> Result<RenderStats, RenderError> {
     let mut band = band_buffer(w, rows_per_band.min(h))?;
-    let mut png = PngStream::create(path, (w, h))?;
+    let spare = band_buffer(w, rows_per_band.min(h))?;
+    let mut png = BandEncoder::spawn(PngStream::create(path, (w, h))?, spare)?;
     let mut stats = RenderStats {
         isa,
         time: Default::default(),
         rays: 0,
     };
     for rows in bands(h, rows_per_band) {
-        let px = &mut band[..(rows.end - rows.start) as usize * w as usize];
-        let s = render_rows(inp, set, TileSet::All, w, h, rows.clone(), px, isa)?;
+        let n = (rows.end - rows.start) as usize * w as usize;
+        let s = render_rows(
+            inp,
+            set,
+            TileSet::All,
+            w,
+            h,
+            rows.clone(),
+            &mut band[..n],
+            isa,
+        )?;
         (stats.time, stats.rays) = (stats.time + s.time, stats.rays + s.rays);
-        png.write_rows(px)?;
+        band = png.write(band, n)?;
         on_rows(rows.end, h);
     }
     png.finish()?;

@@ -8,8 +8,8 @@ use std::path::PathBuf;
 
 use render::{
     accumulate, band_rows, render_frame, render_frame_with_progress, render_png_streamed,
-    render_rows, render_tiles, Accum, Camera, FrameInputs, Framebuffer, Material, Modality,
-    PngStream, RenderSettings, TileSet, View, DARK_BACKGROUND,
+    render_rows, render_tiles, Accum, BandEncoder, Camera, FrameInputs, Framebuffer, Material,
+    Modality, PngStream, RenderSettings, TileSet, View, DARK_BACKGROUND,
 };
 use scene::{Scene, SceneSettings, VolumeSettings};
 use spmd::Isa;
@@ -303,6 +303,28 @@ fn a_stream_dropped_unfinished_leaves_the_old_file_and_no_partial_one() {
     png.finish().unwrap();
     let (w, h, bytes) = decode(&path);
     assert!((w, h) == (16, 4) && bytes.chunks(4).all(|p| p == [255, 0, 0, 255]));
+    // Through the encoder thread: two bands, finished; dropped unfinished, nothing is left.
+    let mut enc =
+        BandEncoder::spawn(PngStream::create(&path, (16, 4)).unwrap(), vec![0; 32]).unwrap();
+    let back = enc.write(vec![0xff00_ff00; 32], 32).unwrap();
+    assert_eq!(back.len(), 32, "the spare buffer");
+    enc.write(back.iter().map(|_| 0xffff_0000).collect(), 32)
+        .unwrap();
+    enc.finish().unwrap();
+    let (_, _, bytes) = decode(&path);
+    assert!(bytes[..128].chunks(4).all(|p| p == [0, 255, 0, 255]));
+    assert!(bytes[128..].chunks(4).all(|p| p == [0, 0, 255, 255]));
+    let mut enc =
+        BandEncoder::spawn(PngStream::create(&path, (16, 4)).unwrap(), vec![0; 32]).unwrap();
+    enc.write(vec![0; 32], 32).unwrap();
+    drop(enc);
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["frame.png"], "the finished image only");
+    let (_, _, again) = decode(&path);
+    assert_eq!(again, bytes, "the earlier image is kept");
     // A directory that is not there: the error names the file.
     let missing = dir.join("no-such-dir").join("frame.png");
     let err = PngStream::create(&missing, (16, 4))

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release --example render_file -- [FILE] [OUT.png]` (default: the adenylate
 //! kinase sample `../shared/data/adk_open.pdb` → `render_file.png`).
-use render::{render_scene, RenderSettings};
+use render::{render_scene, RenderSettings, SceneFrame};
 use scene::{CameraChoice, Input, Orbit, Progress, Scene, SceneSettings, View};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -31,7 +31,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     .camera(scene.sphere, size);
     let settings = RenderSettings::headlight([255, 255, 255]);
-    let image = render_scene(&scene, &camera, &settings, size, None, isa, None)?;
+    let job = SceneFrame {
+        scene: &scene,
+        camera: &camera,
+        settings: &settings,
+        size,
+        legend_ink: None,
+        isa,
+    };
+    let image = render_scene(&job, None)?;
     image.frame.save_png(&out)?;
     println!(
         "{file}: {} atoms → {out} ({:.1} Mrays/s, {})",

@@ -139,19 +139,18 @@ pub fn run(args: RenderArgs, isa: Isa, ranks: Option<&Ranks>) -> Result<()> {
     // BENCHMARKS.md, "Progress bands"), so only when a bar can be seen.
     let mut on_rows = |done: u32, _: u32| pb.set_position(done as u64);
     let on_rows = std::io::stderr().is_terminal().then_some(&mut on_rows as _);
+    let job = render::SceneFrame {
+        scene: &sc,
+        camera: &camera,
+        settings: &settings,
+        size: (w, h),
+        legend_ink: ink,
+        isa,
+    };
     let (stats, legend) = match ranks {
-        None => render_scene_to_file(&sc, &camera, &settings, (w, h), ink, isa, on_rows, &output)?,
+        None => render_scene_to_file(&job, on_rows, &output)?,
         Some(r) => {
-            let f = r.render_scene_to_file(
-                &sc,
-                &camera,
-                &settings,
-                (w, h),
-                ink,
-                isa,
-                on_rows,
-                &output,
-            )?;
+            let f = r.render_scene_to_file(&job, on_rows, &output)?;
             f.describe().into_iter().for_each(verbose);
             (f.stats, f.legend)
         }

@@ -11,11 +11,9 @@ use mpi::traits::*;
 use mpi::Count;
 use render::{
     band_buffer, band_rows, bands, draw_scene_legend, is_streamed, render_rows, BandEncoder,
-    Camera, FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderSettings, RenderStats,
-    TileSet,
+    FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderStats, SceneFrame, TileSet,
 };
 use scene::Scene;
-use spmd::Isa;
 
 use crate::{owned_tiles, pack, segments, unpack, ClusterError, ClusterFrame, RankStats, Ranks};
 
@@ -129,32 +127,38 @@ impl RankStats {
 }
 
 impl Ranks {
-    /// Renders `scene` into the image file `path` with every rank (collective: every rank
-    /// calls it with the same scene, camera, settings and size): as
-    /// `render::render_scene_to_file`, pixel for pixel, with the tiles of each band dealt to
-    /// the ranks round robin and rank 0 gathering and writing. A frame over
-    /// `render::STREAM_ABOVE_BYTES` is streamed in bands. `on_rows` (rank 0) is told the rows
-    /// written. Returns on rank 0 what every rank did.
-    #[allow(clippy::too_many_arguments)]
+    /// Renders `job` into the image file `path` with every rank (collective: every rank calls
+    /// it with the same scene, camera, settings and size): as `render::render_scene_to_file`,
+    /// pixel for pixel, with the tiles of each band dealt to the ranks round robin and rank 0
+    /// gathering and writing. A frame over `render::STREAM_ABOVE_BYTES` is streamed in bands.
+    /// `on_rows` (rank 0) is told the rows written. Returns on rank 0 what every rank did.
     pub fn render_scene_to_file(
         &self,
-        scene: &Scene,
-        camera: &Camera,
-        settings: &RenderSettings,
-        (w, h): (u32, u32),
-        legend_ink: Option<[u8; 3]>,
-        isa: Isa,
+        job: &SceneFrame,
+        on_rows: Option<&mut dyn FnMut(u32, u32)>,
+        path: &Path,
+    ) -> Result<ClusterFrame, ClusterError> {
+        job.with_inputs(|inp| self.share_frame(job, inp, on_rows, path))
+    }
+
+    /// [`Ranks::render_scene_to_file`] with the frame driver's inputs made.
+    fn share_frame(
+        &self,
+        job: &SceneFrame,
+        inp: &FrameInputs,
         mut on_rows: Option<&mut dyn FnMut(u32, u32)>,
         path: &Path,
     ) -> Result<ClusterFrame, ClusterError> {
+        let SceneFrame {
+            scene,
+            settings,
+            size: (w, h),
+            legend_ink,
+            isa,
+            ..
+        } = *job;
         let (rank, ranks) = (self.rank(), self.size());
         let tiles = TileSet::Interleaved { rank, ranks };
-        let vscene = scene.volume_scene(settings.march);
-        let inp = FrameInputs {
-            model: scene.model.as_ref(),
-            volume: vscene.as_ref(),
-            camera,
-        };
         let rows_per_band = if is_streamed((w, h)) { band_rows(w) } else { h };
         // All that can fail on one rank but not the others, before the ranks agree.
         let ready = settings
@@ -173,7 +177,7 @@ impl Ranks {
         for rows in bands(h, rows_per_band) {
             let (px, recv) = buf.band(&rows, w);
             let t = Instant::now();
-            let s = render_rows(&inp, settings, tiles, w, h, rows.clone(), px, isa)
+            let s = render_rows(inp, settings, tiles, w, h, rows.clone(), px, isa)
                 .expect("the settings were validated before the ranks agreed");
             mine.render_s += t.elapsed().as_secs_f64();
             mine.rays += s.rays;

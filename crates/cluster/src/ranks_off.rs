@@ -4,9 +4,7 @@
 use std::convert::Infallible;
 use std::path::Path;
 
-use render::{Camera, RenderSettings};
-use scene::Scene;
-use spmd::Isa;
+use render::SceneFrame;
 
 use crate::{ClusterError, ClusterFrame, Launch};
 
@@ -49,15 +47,9 @@ impl Ranks {
     }
 
     /// Renders a frame over the ranks (see the `mpi` build).
-    #[allow(clippy::too_many_arguments)]
     pub fn render_scene_to_file(
         &self,
-        _scene: &Scene,
-        _camera: &Camera,
-        _settings: &RenderSettings,
-        _size: (u32, u32),
-        _legend_ink: Option<[u8; 3]>,
-        _isa: Isa,
+        _job: &SceneFrame,
         _on_rows: Option<&mut dyn FnMut(u32, u32)>,
         _path: &Path,
     ) -> Result<ClusterFrame, ClusterError> {

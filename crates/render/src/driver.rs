@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
-use scene::{Camera, Model, Scene};
+use scene::{Camera, Model};
 use spmd::Isa;
 use volume::VolumeScene;
 
@@ -42,22 +42,6 @@ impl<'a> FrameInputs<'a> {
             camera,
         }
     }
-}
-
-/// `f` given the inputs of `scene` (its model, and its volume marched with `march`) seen by
-/// `camera`.
-pub fn with_scene_inputs<R>(
-    scene: &Scene,
-    camera: &Camera,
-    march: volume::MarchOptions,
-    f: impl FnOnce(&FrameInputs) -> R,
-) -> R {
-    let vscene = scene.volume_scene(march);
-    f(&FrameInputs {
-        model: scene.model.as_ref(),
-        volume: vscene.as_ref(),
-        camera,
-    })
 }
 
 /// Which tiles (16×16, numbered `tx` across and `ty` down) a call renders.

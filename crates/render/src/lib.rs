@@ -27,8 +27,7 @@ pub use accum::Accum;
 pub use ao_at::ambient_occlusion_at;
 pub use band_encoder::BandEncoder;
 pub use driver::{
-    accumulate, render_frame, render_rows, render_tiles, with_scene_inputs, FrameInputs,
-    RenderStats, TileSet, TILE,
+    accumulate, render_frame, render_rows, render_tiles, FrameInputs, RenderStats, TileSet, TILE,
 };
 pub use framebuffer::{Framebuffer, ImageFormat, RenderError, JPEG_QUALITY};
 pub use integrator::{trace, Traced};
@@ -39,7 +38,7 @@ pub use scene::{
     rgba, viridis, Camera, Coloring, Colormap, Model, ModelOptions, Projection, Style, View,
 };
 pub use scene_image::{
-    check_frame, draw_scene_legend, render_scene, render_scene_to_file, SceneImage,
+    check_frame, draw_scene_legend, render_scene, render_scene_to_file, SceneFrame, SceneImage,
 };
 pub use settings::{
     Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,

@@ -7,7 +7,7 @@ use std::path::Path;
 use scene::Scene;
 use spmd::Isa;
 
-use crate::driver::{render_frame, with_scene_inputs, RenderStats};
+use crate::driver::{render_frame, FrameInputs, RenderStats};
 use crate::framebuffer::{Framebuffer, ImageFormat, RenderError};
 use crate::legend::{draw_legend, Legend};
 use crate::progress::render_frame_with_progress;
@@ -26,25 +26,50 @@ pub struct SceneImage {
     pub legend: Option<(Legend, bool)>,
 }
 
-/// Renders `scene` seen by `camera` into a new frame of `size` pixels with `settings` (its
-/// volume marched with `settings.march`), and draws the legend with text of colour
-/// `legend_ink` when given. `on_rows`, when given, is told the rows finished as bands of the
-/// frame complete (a progress bar; the bands cost idle threads at each band's end).
+/// One frame of a built scene to make: what is seen, how, how large, on which backend. What
+/// [`render_scene`], [`render_scene_to_file`] and the MPI ranks' `cluster::Ranks` take.
+#[derive(Clone, Copy)]
+pub struct SceneFrame<'a> {
+    /// The scene: its model and volume.
+    pub scene: &'a Scene,
+    /// The view.
+    pub camera: &'a Camera,
+    /// How it is rendered (its volume marched with `settings.march`).
+    pub settings: &'a RenderSettings,
+    /// Width and height (pixels).
+    pub size: (u32, u32),
+    /// Colour of the legend's text when a legend is drawn (`None`: no legend).
+    pub legend_ink: Option<[u8; 3]>,
+    /// The SIMD backend (supported by this CPU, see [`Isa::select`]).
+    pub isa: Isa,
+}
+
+impl SceneFrame<'_> {
+    /// `f` given the frame driver's inputs: the scene's model and volume seen by the camera.
+    pub fn with_inputs<R>(&self, f: impl FnOnce(&FrameInputs) -> R) -> R {
+        let vscene = self.scene.volume_scene(self.settings.march);
+        f(&FrameInputs {
+            model: self.scene.model.as_ref(),
+            volume: vscene.as_ref(),
+            camera: self.camera,
+        })
+    }
+}
+
+/// Renders `job` into a new frame and draws the legend when `job.legend_ink` is given.
+/// `on_rows`, when given, is told the rows finished as bands of the frame complete (a
+/// progress bar; the bands cost idle threads at each band's end).
 pub fn render_scene(
-    scene: &Scene,
-    camera: &Camera,
-    settings: &RenderSettings,
-    size: (u32, u32),
-    legend_ink: Option<[u8; 3]>,
-    isa: Isa,
+    job: &SceneFrame,
     on_rows: Option<&mut dyn FnMut(u32, u32)>,
 ) -> Result<SceneImage, RenderError> {
-    let mut frame = Framebuffer::new(size.0, size.1, settings.background_packed())?;
-    let stats = with_scene_inputs(scene, camera, settings.march, |inp| match on_rows {
-        Some(f) => render_frame_with_progress(inp, settings, &mut frame, isa, f),
-        None => render_frame(inp, settings, &mut frame, isa),
+    let (set, isa) = (job.settings, job.isa);
+    let mut frame = Framebuffer::new(job.size.0, job.size.1, set.background_packed())?;
+    let stats = job.with_inputs(|inp| match on_rows {
+        Some(f) => render_frame_with_progress(inp, set, &mut frame, isa, f),
+        None => render_frame(inp, set, &mut frame, isa),
     })?;
-    let legend = draw_scene_legend(scene, &mut frame, legend_ink);
+    let legend = draw_scene_legend(job.scene, &mut frame, job.legend_ink);
     Ok(SceneImage {
         frame,
         stats,
@@ -98,32 +123,26 @@ pub fn check_frame(size: (u32, u32), path: &Path, legend: bool) -> Result<(), Re
     }
 }
 
-/// Renders `scene` to the image file `path` as `bnsview render` does: whole, with the legend
+/// Renders `job` to the image file `path` as `bnsview render` does: whole, with the legend
 /// ([`render_scene`]), saved in the format of its name; or, for a frame [`is_streamed`], band by
 /// band into a PNG ([`render_png_streamed`]; call [`check_frame`] first). `on_rows` as in
 /// [`render_scene`] (a streamed frame reports its bands always). Returns what rendering did
 /// and the legend, as [`SceneImage`].
-#[allow(clippy::too_many_arguments)]
 pub fn render_scene_to_file(
-    scene: &Scene,
-    camera: &Camera,
-    settings: &RenderSettings,
-    size: (u32, u32),
-    legend_ink: Option<[u8; 3]>,
-    isa: Isa,
+    job: &SceneFrame,
     on_rows: Option<&mut dyn FnMut(u32, u32)>,
     path: &Path,
 ) -> Result<(RenderStats, Option<(Legend, bool)>), RenderError> {
-    if !is_streamed(size) {
-        let image = render_scene(scene, camera, settings, size, legend_ink, isa, on_rows)?;
+    if !is_streamed(job.size) {
+        let image = render_scene(job, on_rows)?;
         image.frame.save(path)?;
         return Ok((image.stats, image.legend));
     }
     let mut none = |_, _| {};
     let on_rows = on_rows.unwrap_or(&mut none);
-    let rows = band_rows(size.0);
-    let stats = with_scene_inputs(scene, camera, settings.march, |inp| {
-        render_png_streamed(inp, settings, size, rows, path, isa, on_rows)
+    let rows = band_rows(job.size.0);
+    let stats = job.with_inputs(|inp| {
+        render_png_streamed(inp, job.settings, job.size, rows, path, job.isa, on_rows)
     })?;
     Ok((stats, None))
 }

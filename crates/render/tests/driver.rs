@@ -76,7 +76,6 @@ const H: u32 = 37;
 #[test]
 fn every_ranks_tiles_together_are_the_whole_frame() {
     let sc = scene();
-    let model = sc.model.as_ref().unwrap();
     let cam = Camera::view(
         View::Far,
         sc.sphere.center,
@@ -84,57 +83,46 @@ fn every_ranks_tiles_together_are_the_whole_frame() {
         45.0,
         W as f32 / H as f32,
     );
-    for isa in Isa::under_test() {
-        for (name, set, vol) in settings() {
-            let vs = sc.volume_scene(set.march).filter(|_| vol);
-            let inp = FrameInputs {
-                model: Some(model),
-                volume: vs.as_ref(),
-                camera: &cam,
-            };
-            let mut whole = Framebuffer::new(W, H, 0).unwrap();
-            render_frame(&inp, &set, &mut whole, isa).unwrap();
-            for ranks in [1, 2, 3, 7] {
-                // Every rank renders into the same buffer; each pixel is written by one rank.
-                let mut union = Framebuffer::new(W, H, 0x1234_5678).unwrap();
-                for rank in 0..ranks {
-                    render_tiles(
-                        &inp,
-                        &set,
-                        TileSet::Interleaved { rank, ranks },
-                        &mut union,
-                        isa,
-                    )
-                    .unwrap();
-                }
-                assert!(
-                    union == whole,
-                    "{isa} {name}: {ranks} ranks differ from one frame"
-                );
+    for_every_case(&sc, &cam, (W, H), |isa, name, set, inp, whole| {
+        for ranks in [1, 2, 3, 7] {
+            // Every rank renders into the same buffer; each pixel is written by one rank.
+            let mut union = Framebuffer::new(W, H, 0x1234_5678).unwrap();
+            for rank in 0..ranks {
+                render_tiles(
+                    inp,
+                    set,
+                    TileSet::Interleaved { rank, ranks },
+                    &mut union,
+                    isa,
+                )
+                .unwrap();
             }
-            // A rank's own tiles alone leave the others untouched.
-            let mut one = Framebuffer::new(W, H, 7).unwrap();
-            render_tiles(
-                &inp,
-                &set,
-                TileSet::Interleaved { rank: 1, ranks: 2 },
-                &mut one,
-                isa,
-            )
-            .unwrap();
-            let untouched = one.pixels.iter().filter(|&&p| p == 7).count();
             assert!(
-                untouched > 0 && untouched < one.pixels.len(),
-                "{isa} {name}"
+                union == *whole,
+                "{isa} {name}: {ranks} ranks differ from one frame"
             );
         }
-    }
+        // A rank's own tiles alone leave the others untouched.
+        let mut one = Framebuffer::new(W, H, 7).unwrap();
+        render_tiles(
+            inp,
+            set,
+            TileSet::Interleaved { rank: 1, ranks: 2 },
+            &mut one,
+            isa,
+        )
+        .unwrap();
+        let untouched = one.pixels.iter().filter(|&&p| p == 7).count();
+        assert!(
+            untouched > 0 && untouched < one.pixels.len(),
+            "{isa} {name}"
+        );
+    });
 }
 
 #[test]
 fn row_bands_together_are_the_whole_frame() {
     let sc = scene();
-    let model = sc.model.as_ref().unwrap();
     let cam = Camera::view(
         View::Close,
         sc.sphere.center,
@@ -142,37 +130,27 @@ fn row_bands_together_are_the_whole_frame() {
         45.0,
         W as f32 / H as f32,
     );
-    for isa in Isa::under_test() {
-        for (name, set, vol) in settings() {
-            let vs = sc.volume_scene(set.march).filter(|_| vol);
-            let inp = FrameInputs {
-                model: Some(model),
-                volume: vs.as_ref(),
-                camera: &cam,
-            };
-            let mut whole = Framebuffer::new(W, H, 0).unwrap();
-            render_frame(&inp, &set, &mut whole, isa).unwrap();
-            // Bands that start and end inside tiles, one a single row.
-            let mut rows = Vec::new();
-            for (a, b) in [(0, 5), (5, 6), (6, 20), (20, H)] {
-                let mut band = vec![0u32; ((b - a) * W) as usize];
-                render_rows(&inp, &set, TileSet::All, W, H, a..b, &mut band, isa).unwrap();
-                rows.extend(band);
-            }
-            assert!(
-                rows == whole.pixels,
-                "{isa} {name}: bands differ from one frame"
-            );
-            // The progress bar's bands: the same frame, rows reported in order up to H.
-            let mut banded = Framebuffer::new(W, H, 0).unwrap();
-            let mut done = Vec::new();
-            render_frame_with_progress(&inp, &set, &mut banded, isa, &mut |d, h| done.push((d, h)))
-                .unwrap();
-            assert!(banded == whole, "{isa} {name}: progress bands differ");
-            assert!(done.len() > 1 && done.last() == Some(&(H, H)), "{done:?}");
-            assert!(done.windows(2).all(|p| p[0].0 < p[1].0), "{done:?}");
+    for_every_case(&sc, &cam, (W, H), |isa, name, set, inp, whole| {
+        // Bands that start and end inside tiles, one a single row.
+        let mut rows = Vec::new();
+        for (a, b) in [(0, 5), (5, 6), (6, 20), (20, H)] {
+            let mut band = vec![0u32; ((b - a) * W) as usize];
+            render_rows(inp, set, TileSet::All, W, H, a..b, &mut band, isa).unwrap();
+            rows.extend(band);
         }
-    }
+        assert!(
+            rows == whole.pixels,
+            "{isa} {name}: bands differ from one frame"
+        );
+        // The progress bar's bands: the same frame, rows reported in order up to H.
+        let mut banded = Framebuffer::new(W, H, 0).unwrap();
+        let mut done = Vec::new();
+        render_frame_with_progress(inp, set, &mut banded, isa, &mut |d, h| done.push((d, h)))
+            .unwrap();
+        assert!(banded == *whole, "{isa} {name}: progress bands differ");
+        assert!(done.len() > 1 && done.last() == Some(&(H, H)), "{done:?}");
+        assert!(done.windows(2).all(|p| p[0].0 < p[1].0), "{done:?}");
+    });
 }
 
 #[test]
@@ -213,11 +191,56 @@ fn decode(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
     (im.width(), im.height(), im.into_raw())
 }
 
+/// Calls `check(isa, name, settings, inputs, whole)` for every backend under test and every
+/// setting of [`settings`]: the scene `sc` seen by `cam` (its volume only where the setting
+/// wants it), `whole` the `size` frame one call of the driver renders.
+fn for_every_case(
+    sc: &Scene,
+    cam: &Camera,
+    (w, h): (u32, u32),
+    mut check: impl FnMut(Isa, &str, &RenderSettings, &FrameInputs, &Framebuffer),
+) {
+    for isa in Isa::under_test() {
+        for (name, set, vol) in settings() {
+            let vs = sc.volume_scene(set.march).filter(|_| vol);
+            let inp = FrameInputs {
+                model: sc.model.as_ref(),
+                volume: vs.as_ref(),
+                camera: cam,
+            };
+            let mut whole = Framebuffer::new(w, h, 0).unwrap();
+            render_frame(&inp, &set, &mut whole, isa).unwrap();
+            check(isa, name, &set, &inp, &whole);
+        }
+    }
+}
+
+/// Streams the frame of `whole`'s size into `path` in bands of `rows` rows and checks the
+/// decoded PNG is `whole`; returns the rows reported done and the rays cast.
+fn assert_streamed_is_whole(
+    inp: &FrameInputs,
+    set: &RenderSettings,
+    whole: &Framebuffer,
+    rows: u32,
+    path: &std::path::Path,
+    isa: Isa,
+) -> (Vec<u32>, u64) {
+    let (w, h) = (whole.width, whole.height);
+    let mut done = Vec::new();
+    let stats =
+        render_png_streamed(inp, set, (w, h), rows, path, isa, &mut |d, _| done.push(d)).unwrap();
+    let (dw, dh, bytes) = decode(path);
+    assert!(
+        (dw, dh) == (w, h) && bytes == *whole.as_bytes(),
+        "{isa}, bands of {rows} rows: the streamed PNG differs from the frame rendered whole"
+    );
+    (done, stats.rays)
+}
+
 #[test]
 fn a_frame_streamed_in_bands_decodes_to_the_frame_rendered_whole() {
     let dir = temp_dir("streamed");
     let sc = scene();
-    let model = sc.model.as_ref().unwrap();
     let (w, h) = (203, 150); // partial tiles at both edges; bands of 32 rows: five bands
     let cam = Camera::view(
         View::Far,
@@ -226,34 +249,12 @@ fn a_frame_streamed_in_bands_decodes_to_the_frame_rendered_whole() {
         45.0,
         203.0 / 150.0,
     );
-    for isa in Isa::under_test() {
-        for (name, set, vol) in settings() {
-            let vs = sc.volume_scene(set.march).filter(|_| vol);
-            let inp = FrameInputs {
-                model: Some(model),
-                volume: vs.as_ref(),
-                camera: &cam,
-            };
-            let mut whole = Framebuffer::new(w, h, 0).unwrap();
-            render_frame(&inp, &set, &mut whole, isa).unwrap();
-            let path = dir.join(format!("{name}-{isa}.png"));
-            let mut done = Vec::new();
-            let stats =
-                render_png_streamed(&inp, &set, (w, h), 32, &path, isa, &mut |d, _| done.push(d))
-                    .unwrap();
-            assert_eq!(done, [32, 64, 96, 128, 150], "{isa} {name}");
-            assert_eq!(
-                stats.rays,
-                u64::from(w * h * set.frame_samples()),
-                "{isa} {name}"
-            );
-            let (dw, dh, bytes) = decode(&path);
-            assert!(
-                (dw, dh) == (w, h) && bytes == *whole.as_bytes(),
-                "{isa} {name}: the streamed PNG differs from the frame rendered whole"
-            );
-        }
-    }
+    for_every_case(&sc, &cam, (w, h), |isa, name, set, inp, whole| {
+        let path = dir.join(format!("{name}-{isa}.png"));
+        let (done, rays) = assert_streamed_is_whole(inp, set, whole, 32, &path, isa);
+        assert_eq!(done, [32, 64, 96, 128, 150], "{isa} {name}");
+        assert_eq!(rays, u64::from(w * h * set.frame_samples()), "{isa} {name}");
+    });
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -272,12 +273,7 @@ fn a_4096_square_frame_streamed_in_bands_is_the_frame_rendered_whole() {
     assert_eq!(band_rows(w), 4096);
     for rows in [band_rows(w), 512] {
         let path = dir.join(format!("bands-{rows}.png"));
-        render_png_streamed(&inp, &set, (w, h), rows, &path, isa, &mut |_, _| {}).unwrap();
-        let (dw, dh, bytes) = decode(&path);
-        assert!(
-            (dw, dh) == (w, h) && bytes == *whole.as_bytes(),
-            "bands of {rows} rows"
-        );
+        assert_streamed_is_whole(&inp, &set, &whole, rows, &path, isa);
     }
     std::fs::remove_dir_all(dir).ok();
 }

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use molecule::read::Trajectory;
 use molecule::Molecule;
-use render::{render_scene, Camera, RenderSettings};
+use render::{render_scene, Camera, RenderSettings, SceneFrame};
 use scene::{CameraChoice, ColorBy, Scene, SceneSettings};
 use spmd::Isa;
 
@@ -278,15 +278,15 @@ fn run_series(
     };
     let mut render_one = |b: Built, wait_s: f64| -> Result<(), SeriesError> {
         let t = Instant::now();
-        let image = render_scene(
-            &b.scene,
-            &camera,
-            &s.render,
-            s.size,
-            s.legend_ink,
-            s.isa,
-            None,
-        )?;
+        let job = SceneFrame {
+            scene: &b.scene,
+            camera: &camera,
+            settings: &s.render,
+            size: s.size,
+            legend_ink: s.legend_ink,
+            isa: s.isa,
+        };
+        let image = render_scene(&job, None)?;
         let render_s = t.elapsed().as_secs_f64();
         let unwrap = b.scene.unwrap;
         drop(b.scene);

@@ -33,8 +33,18 @@ mod with_mpi {
     /// `mpirun -np 2 bnsview ARGS` (as root in CI, more ranks than cores allowed), with a
     /// time limit so that a hang fails the test instead of the CI job: success, stderr.
     fn mpirun(args: &[&str], dir: &Path) -> (bool, String) {
+        mpirun_np(2, args, dir)
+    }
+
+    /// [`mpirun`] with `np` ranks.
+    fn mpirun_np(np: usize, args: &[&str], dir: &Path) -> (bool, String) {
         let mut c = Command::new("mpirun");
-        c.args(["--allow-run-as-root", "--oversubscribe", "-np", "2"]);
+        c.args([
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-np",
+            &np.to_string(),
+        ]);
         c.arg(env!("CARGO_BIN_EXE_bnsview"))
             .args(args)
             .current_dir(dir);
@@ -64,9 +74,14 @@ mod with_mpi {
     /// Renders `args` with 2 ranks and with one process (one thread each) into `dir` and
     /// checks the files are identical; returns the ranks' stderr.
     fn same_as_one_process(args: &[&str], dir: &Path, name: &str) -> String {
-        let (two, one) = (format!("{name}-2.png"), format!("{name}-1.png"));
+        same_with_ranks(2, args, dir, name)
+    }
+
+    /// [`same_as_one_process`] with `np` ranks.
+    fn same_with_ranks(np: usize, args: &[&str], dir: &Path, name: &str) -> String {
+        let (two, one) = (format!("{name}-{np}.png"), format!("{name}-1.png"));
         let base = ["render", "--threads", "1", "-v"];
-        let (ok, err) = mpirun(&[&base[..], args, &["-o", &two]].concat(), dir);
+        let (ok, err) = mpirun_np(np, &[&base[..], args, &["-o", &two]].concat(), dir);
         assert!(ok, "{name}: {err}");
         let (ok, _, err1) = run(bnsview()
             .args(base)
@@ -80,7 +95,7 @@ mod with_mpi {
         );
         assert!(
             a == b,
-            "{name}: the image of 2 ranks differs from one process's"
+            "{name}: the image of {np} ranks differs from one process's"
         );
         err
     }
@@ -101,11 +116,22 @@ mod with_mpi {
             ("path", &["--mode", "path", "--spp", "3"][..]),
         ] {
             let err = same_as_one_process(&[&scene[..], flags].concat(), &d, name);
-            // -v: each rank's tiles (13 x 10 tiles: 65 each), reported once, by rank 0.
+            // -v: each rank's tiles (13 x 10 tiles: 5 rows of 13 each), reported once, by
+            // rank 0.
             for r in ["rank 0/2: 65 tiles", "rank 1/2: 65 tiles"] {
                 assert_eq!(err.matches(r).count(), 1, "{name}: {err}");
             }
             assert_eq!(err.matches("wrote ").count(), 1, "{name}: {err}");
+        }
+        // 3 ranks: rows of tiles 0, 3, 6, 9 | 1, 4, 7 | 2, 5, 8 (a rank with fewer rows, and
+        // rank 0 receiving from two).
+        let err = same_with_ranks(3, &scene, &d, "bs3");
+        for r in [
+            "rank 0/3: 52 tiles",
+            "rank 1/3: 39 tiles",
+            "rank 2/3: 39 tiles",
+        ] {
+            assert_eq!(err.matches(r).count(), 1, "3 ranks: {err}");
         }
         std::fs::remove_dir_all(d).ok();
     }

@@ -1,21 +1,19 @@
-//! One frame rendered by every rank (the paper's image-parallel renderer): the tiles of each
-//! band dealt round robin, rendered by each rank's threads, gathered by rank 0 into the frame
-//! or into the streamed PNG of a giant frame.
+//! One frame rendered by every rank (the paper's image-parallel renderer): the rows of tiles of
+//! each band dealt round robin, rendered by each rank's threads, received by rank 0 straight
+//! into the frame or into the band of a giant frame's streamed PNG.
 
 use std::ops::Range;
 use std::path::Path;
 use std::time::Instant;
 
-use mpi::datatype::PartitionMut;
 use mpi::traits::*;
-use mpi::Count;
 use render::{
     band_buffer, band_rows, bands, draw_scene_legend, is_streamed, render_rows, BandEncoder,
     FrameInputs, Framebuffer, Legend, PngStream, RenderError, RenderStats, SceneFrame, TileSet,
 };
 use scene::Scene;
 
-use crate::{owned_tiles, pack, segments, unpack, ClusterError, ClusterFrame, RankStats, Ranks};
+use crate::{owned_tiles, row_owner, tile_rows, ClusterError, ClusterFrame, RankStats, Ranks};
 
 /// Where a rank's band of pixels lives.
 enum Out {
@@ -24,15 +22,13 @@ enum Out {
     /// Rank 0 of a giant frame: the band, then to the PNG's encoder thread (which gives back
     /// the buffer of the band before).
     Streamed(Box<BandEncoder>, Vec<u32>),
-    /// Any other rank: its band, whose tiles are sent to rank 0.
+    /// Any other rank: its band, whose rows of tiles are sent to rank 0.
     Worker(Vec<u32>),
 }
 
 /// A rank's buffers for one frame, allocated before the ranks agree to render.
 struct Buffers {
     out: Out,
-    /// Rank 0: the other ranks' pixels of a band.
-    recv: Vec<u32>,
 }
 
 impl Buffers {
@@ -52,21 +48,19 @@ impl Buffers {
                 Out::Streamed(Box::new(BandEncoder::spawn(png, band()?)?), band()?)
             }
         };
-        let recv = if root { band()? } else { Vec::new() };
-        Ok(Buffers { out, recv })
+        Ok(Buffers { out })
     }
 
-    /// The pixels of band `rows` of a frame `w` wide, and rank 0's receive buffer.
-    fn band(&mut self, rows: &Range<u32>, w: u32) -> (&mut [u32], &mut [u32]) {
+    /// The pixels of band `rows` of a frame `w` wide.
+    fn band(&mut self, rows: &Range<u32>, w: u32) -> &mut [u32] {
         let (a, b) = (
             rows.start as usize * w as usize,
             rows.end as usize * w as usize,
         );
-        let px = match &mut self.out {
+        match &mut self.out {
             Out::Whole(fb) => &mut fb.pixels[a..b],
             Out::Streamed(_, band) | Out::Worker(band) => &mut band[..b - a],
-        };
-        (px, &mut self.recv)
+        }
     }
 
     /// Rank 0: the finished band `rows` into the PNG of a giant frame.
@@ -108,6 +102,9 @@ impl Buffers {
     }
 }
 
+/// Rows of tiles whose messages are under way at once (each row of tiles is one message).
+const REQUESTS_AT_ONCE: usize = 1024;
+
 impl RankStats {
     /// As four numbers for one message: tiles, rays, render and wall time in nanoseconds.
     fn to_words(self) -> [u64; 4] {
@@ -129,8 +126,8 @@ impl RankStats {
 impl Ranks {
     /// Renders `job` into the image file `path` with every rank (collective: every rank calls
     /// it with the same scene, camera, settings and size): as `render::render_scene_to_file`,
-    /// pixel for pixel, with the tiles of each band dealt to the ranks round robin and rank 0
-    /// gathering and writing. A frame over `render::STREAM_ABOVE_BYTES` is streamed in bands.
+    /// pixel for pixel, with the rows of tiles of each band dealt to the ranks round robin and
+    /// rank 0 receiving and writing. A frame over `render::STREAM_ABOVE_BYTES` is streamed in bands.
     /// `on_rows` (rank 0) is told the rows written. Returns on rank 0 what every rank did.
     pub fn render_scene_to_file(
         &self,
@@ -158,7 +155,8 @@ impl Ranks {
             ..
         } = *job;
         let (rank, ranks) = (self.rank(), self.size());
-        let tiles = TileSet::Interleaved { rank, ranks };
+        let mine = move |_tx: usize, ty: usize| row_owner(ty, ranks) == rank;
+        let tiles = TileSet::Where(&mine);
         let rows_per_band = if is_streamed((w, h)) { band_rows(w) } else { h };
         // All that can fail on one rank but not the others, before the ranks agree.
         let ready = settings
@@ -171,22 +169,18 @@ impl Ranks {
         let mut buf = self.agree(ready.map_err(|e| e.to_string()))?;
         let root = self.world.process_at_rank(0);
         let start = Instant::now();
-        let mut mine = RankStats::default();
+        let mut done = RankStats::default();
         // Rank 0's last write; the others learn of it at the next band.
         let mut written: Result<(), RenderError> = Ok(());
         for rows in bands(h, rows_per_band) {
-            let (px, recv) = buf.band(&rows, w);
+            let px = buf.band(&rows, w);
             let t = Instant::now();
             let s = render_rows(inp, settings, tiles, w, h, rows.clone(), px, isa)
                 .expect("the settings were validated before the ranks agreed");
-            mine.render_s += t.elapsed().as_secs_f64();
-            mine.rays += s.rays;
-            mine.tiles += owned_tiles(w, rows.clone(), &tiles) as u64;
-            if rank == 0 {
-                self.gather_band(px, recv, w, &rows);
-            } else {
-                root.gather_varcount_into(&pack(px, w, rows.clone(), &tiles)[..]);
-            }
+            done.render_s += t.elapsed().as_secs_f64();
+            done.rays += s.rays;
+            done.tiles += owned_tiles(w, rows.clone(), rank, ranks) as u64;
+            self.share_band(px, w, &rows);
             self.go_on(&written)?;
             if rank == 0 {
                 written = buf.write(&rows, w);
@@ -195,28 +189,28 @@ impl Ranks {
                 }
             }
         }
-        mine.wall_s = start.elapsed().as_secs_f64();
+        done.wall_s = start.elapsed().as_secs_f64();
         let mut legend = None;
         if rank == 0 {
             written =
                 written.and_then(|()| buf.finish(scene, legend_ink, path).map(|l| legend = l));
         }
         self.go_on(&written)?;
-        let words = mine.to_words();
+        let words = done.to_words();
         if rank != 0 {
             root.gather_into(&words[..]);
             return Ok(ClusterFrame {
                 stats: RenderStats {
                     isa,
                     time: start.elapsed(),
-                    rays: mine.rays,
+                    rays: done.rays,
                 },
                 legend: None,
                 ranks: Vec::new(),
             });
         }
         // The frame's time: its bands rendered, gathered (and streamed), not the file saved.
-        let time = std::time::Duration::from_secs_f64(mine.wall_s);
+        let time = std::time::Duration::from_secs_f64(done.wall_s);
         let mut all = vec![0u64; 4 * ranks];
         root.gather_into_root(&words[..], &mut all[..]);
         let per_rank: Vec<RankStats> = all.chunks(4).map(RankStats::from_words).collect();
@@ -231,30 +225,43 @@ impl Ranks {
         })
     }
 
-    /// Rank 0: every other rank's tiles of band `rows` received into `recv` and unpacked
-    /// into `px` (rank 0's own tiles are already there).
-    fn gather_band(&self, px: &mut [u32], recv: &mut [u32], w: u32, rows: &Range<u32>) {
-        let ranks = self.size();
-        let share = |r| TileSet::Interleaved { rank: r, ranks };
-        let counts: Vec<Count> = (0..ranks)
-            .map(|r| match r {
-                0 => 0,
-                _ => segments(w, rows.clone(), &share(r))
-                    .map(|s| s.1 as Count)
-                    .sum(),
-            })
-            .collect();
-        let displs: Vec<Count> = counts
-            .iter()
-            .scan(0, |at, &c| Some(std::mem::replace(at, *at + c)))
-            .collect();
-        let total = counts.iter().sum::<Count>() as usize;
-        let mut part = PartitionMut::new(&mut recv[..total], &counts[..], &displs[..]);
-        let root = self.world.process_at_rank(0);
-        root.gather_varcount_into_root(&[0u32; 0][..], &mut part);
-        for r in 1..ranks {
-            let (a, n) = (displs[r] as usize, counts[r] as usize);
-            unpack(&recv[a..a + n], px, w, rows.clone(), &share(r));
+    /// Collective: the rows of tiles of band `rows` (a frame `w` wide) that each rank
+    /// rendered into its `px`, received by rank 0 into its `px` in place (no packing: a row of
+    /// tiles is contiguous); rank 0's own rows are already there. Single tiles packed and
+    /// gathered cost 5× the wait (ARCHITECTURE.md, "Rejected").
+    fn share_band(&self, px: &mut [u32], w: u32, rows: &Range<u32>) {
+        let (rank, ranks) = (self.rank(), self.size());
+        // Each row of tiles as its own slice of the band, with the rank that rendered it, in
+        // groups of the same rows of tiles on every rank (so a tall narrow frame does not post
+        // a million requests at once, and each group's sends meet its receives).
+        let mut groups: Vec<Vec<(usize, &mut [u32])>> = Vec::new();
+        let mut rest = px;
+        for (i, (owner, run)) in tile_rows(w, rows.clone(), ranks).enumerate() {
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(run.len());
+            rest = tail;
+            if i % REQUESTS_AT_ONCE == 0 {
+                groups.push(Vec::new());
+            }
+            if owner != 0 && (rank == 0 || owner == rank) {
+                groups.last_mut().expect("pushed above").push((owner, part));
+            }
+        }
+        for group in &mut groups {
+            mpi::request::scope(|scope| {
+                let pending: Vec<_> = group
+                    .iter_mut()
+                    .map(|(owner, part)| match rank {
+                        0 => self
+                            .world
+                            .process_at_rank(*owner as i32)
+                            .immediate_receive_into(scope, &mut **part),
+                        _ => self.world.process_at_rank(0).immediate_send(scope, &**part),
+                    })
+                    .collect();
+                for p in pending {
+                    p.wait();
+                }
+            });
         }
     }
 

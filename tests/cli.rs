@@ -190,6 +190,58 @@ fn views_orbit_and_zoom_move_the_camera_and_v_prints_it_as_a_camera_spec() {
 }
 
 #[test]
+fn v_and_info_report_bytes_per_atom_of_records_and_nodes_and_the_build_rate() {
+    let d = scratch("bytes-per-atom");
+    let (ok, _, err) = run(bnsview()
+        .args([
+            "render", "--scene", "nanobowl", "--atoms", "2000", "--size", "40x30",
+        ])
+        .args(["-v", "-o"])
+        .arg(d.join("a.png")));
+    assert!(ok, "{err}");
+    // bvh: T s  N prims, M nodes, SAH S, X MB (Y B/atom): records R + nodes K B/atom, P M prims/s
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("bvh:"))
+        .expect("bvh line");
+    let num = |after: &str| -> f64 {
+        let rest = &line[line
+            .find(after)
+            .unwrap_or_else(|| panic!("{after} in {line}"))
+            + after.len()..];
+        rest.split(|c: char| c != '.' && !c.is_ascii_digit())
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let total = num("MB (");
+    let (records, nodes) = (num("records "), num("+ nodes "));
+    assert!(
+        line.contains(&format!("({total:.1} B/atom): records")),
+        "{line}"
+    );
+    assert!((records + nodes - total).abs() <= 0.11, "{line}");
+    assert!(
+        num("B/atom, ") > 0.0 && line.contains(" M prims/s"),
+        "{line}"
+    );
+    // info: bytes per atom beside every component that grows with the atoms.
+    let (ok, out, err) = run(bnsview().args(["info", "--scene", "nanobowl", "--atoms", "2000"]));
+    assert!(ok, "{err}");
+    for part in ["    geometry", "    bvh", "    atoms"] {
+        let l = out.lines().find(|l| l.starts_with(part)).expect(part);
+        assert!(l.ends_with(" B/atom)"), "{l}");
+    }
+    let fb = out
+        .lines()
+        .find(|l| l.starts_with("    framebuffer"))
+        .unwrap();
+    assert!(!fb.contains("B/atom"), "{fb}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
 fn render_reports_bad_input_with_file_and_line() {
     let d = scratch("bad");
     let f = d.join("broken.xyz");

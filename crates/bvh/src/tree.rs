@@ -94,6 +94,8 @@ pub struct BuildStats {
     pub sah_cost: f64,
     /// Bytes of nodes + primitive ids + primitive records.
     pub bytes: usize,
+    /// Bytes of the primitive records alone (the kernels' copy of the geometry, 32 B each).
+    pub record_bytes: usize,
 }
 
 impl BuildStats {
@@ -104,6 +106,14 @@ impl BuildStats {
     /// Bytes of BVH + kernel geometry per atom.
     pub fn bytes_per_atom(&self) -> f64 {
         self.bytes as f64 / self.atoms.max(1) as f64
+    }
+    /// Bytes per atom of the primitive records (the kernels' copy of the geometry).
+    pub fn record_bytes_per_atom(&self) -> f64 {
+        self.record_bytes as f64 / self.atoms.max(1) as f64
+    }
+    /// Bytes per atom of the tree itself (nodes and primitive ids).
+    pub fn node_bytes_per_atom(&self) -> f64 {
+        (self.bytes - self.record_bytes) as f64 / self.atoms.max(1) as f64
     }
 }
 
@@ -142,9 +152,8 @@ impl Bvh {
         let bounds = nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
         let build_time = start.elapsed();
         let (leaves, max_depth, sah_cost) = tree_figures(&nodes);
-        let bytes = nodes.len() * size_of::<Node>()
-            + order.len() * size_of::<u32>()
-            + records.len() * size_of::<PrimRecord>();
+        let record_bytes = records.len() * size_of::<PrimRecord>();
+        let bytes = nodes.len() * size_of::<Node>() + order.len() * size_of::<u32>() + record_bytes;
         let stats = BuildStats {
             builder,
             build_time,
@@ -155,6 +164,7 @@ impl Bvh {
             max_depth,
             sah_cost,
             bytes,
+            record_bytes,
         };
         Bvh {
             nodes,

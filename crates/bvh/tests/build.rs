@@ -26,6 +26,15 @@ fn binned_sah_close_to_full_sweep() {
         // Goal is within 5%; the test allows 8% so it checks the builder, not the bin count.
         assert!(ratio < 1.08, "binned SAH {ratio} × full sweep");
         assert!(b.stats.bytes_per_atom() > 0.0);
+        // The parts `render -v` reports, counted from the arrays: 32 B records per slot,
+        // 32 B nodes and 4 B ids; they add up to the total.
+        let st = &b.stats;
+        let per_atom = |bytes: usize| bytes as f64 / st.atoms as f64;
+        let records = b.records.len() * 32;
+        assert_eq!(st.record_bytes_per_atom(), per_atom(records));
+        let nodes = b.nodes.len() * 32 + b.prim_ids.len() * 4;
+        assert_eq!(st.node_bytes_per_atom(), per_atom(nodes));
+        assert_eq!(st.bytes, records + nodes);
     }
 }
 

@@ -242,8 +242,13 @@ impl<'a> Description<'a> {
         let est = self.largest();
         line(format!("  at rest (vol+bs), {:.1} MB:", mb(est.total())));
         for (name, bytes) in est.components() {
+            // Bytes per atom for what grows with the atoms (#19's measure), not the frame.
+            let per_atom = match (name, m.len()) {
+                ("framebuffer", _) | (_, 0) => String::new(),
+                (_, n) => format!("  ({:.1} B/atom)", bytes as f64 / n as f64),
+            };
             if bytes > 0 {
-                line(format!("    {name:<12} {:>10.1} MB", mb(bytes)));
+                line(format!("    {name:<12} {:>10.1} MB{per_atom}", mb(bytes)));
             }
         }
         let d = est.volume_dims.unwrap_or([0; 3]);

@@ -4,7 +4,9 @@ use crate::build::Scene;
 
 impl Scene {
     /// One line per built stage (`unwrap:`, `bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
-    /// and the figures a user checks first (BVH nodes and SAH cost, lattice points, MB).
+    /// and the figures a user checks first (BVH nodes and SAH cost, lattice points, MB). The
+    /// `bvh:` line gives bytes per atom in all (the kernels' primitive records + nodes and ids), then
+    /// each part, and the build rate in million primitives per second.
     pub fn stage_report(&self) -> Vec<String> {
         let mut out = Vec::new();
         let t = &self.timings;
@@ -19,13 +21,16 @@ impl Scene {
             ));
             let st = &model.bvh.stats;
             out.push(format!(
-                "bvh:     {:.3} s  {} prims, {} nodes, SAH {:.1}, {:.1} MB ({:.1} B/atom), scene build {:.3} s",
+                "bvh:     {:.3} s  {} prims, {} nodes, SAH {:.1}, {:.1} MB ({:.1} B/atom): records {:.1} + nodes {:.1} B/atom, {:.2} M prims/s, scene build {:.3} s",
                 st.build_time.as_secs_f64(),
                 st.prims,
                 st.nodes,
                 st.sah_cost,
                 st.bytes as f64 / 1e6,
                 st.bytes_per_atom(),
+                st.record_bytes_per_atom(),
+                st.node_bytes_per_atom(),
+                st.prims_per_second() * 1e-6,
                 t.model
             ));
         }

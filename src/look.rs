@@ -120,6 +120,11 @@ pub struct LookArgs {
     /// Volume: post-classification instead of pre-integration, for comparison.
     #[arg(help_heading = "Volume", long)]
     pub no_preintegration: bool,
+    /// Memory the scene build may use, MB (10⁶ bytes): its estimated peak (what `bnsview info`
+    /// prints) is checked against this before anything large is allocated. Default: 75 % of
+    /// the memory available (`MemAvailable`) when the build starts.
+    #[arg(help_heading = "Performance", long, value_name = "MB", value_parser = clap::value_parser!(u64).range(1..))]
+    pub memory_budget: Option<u64>,
     /// Worker threads (default: all cores).
     #[arg(help_heading = "Performance", long)]
     pub threads: Option<usize>,
@@ -187,6 +192,7 @@ impl LookArgs {
             bounces: self.bounce_traversal,
             macrocells: !self.no_macrocells,
             preintegrated: !self.no_preintegration,
+            memory_budget: self.memory_budget.map(|mb| mb.saturating_mul(1_000_000)),
         })
     }
 

@@ -241,6 +241,36 @@ fn v_and_info_report_bytes_per_atom_of_records_and_nodes_and_the_build_rate() {
     std::fs::remove_dir_all(&d).ok();
 }
 
+/// The memory budget: a scene over it is refused before the build, saying how much it needs
+/// and how to get by (`--memory-budget` among the ways out), and nothing is written; a budget
+/// above the estimate renders. The estimate is `info`'s figure, independent of the render.
+#[test]
+fn memory_budget_refuses_with_the_way_out_and_allows_what_fits() {
+    let d = scratch("memory-budget");
+    let out = d.join("a.png");
+    let render = |budget: &str| {
+        run(bnsview()
+            .args([
+                "render", "--scene", "ns90k", "--atoms", "20000", "--size", "40x30",
+            ])
+            .args(["--memory-budget", budget, "-o"])
+            .arg(&out))
+    };
+    let (ok, _, err) = render("1");
+    assert!(!ok);
+    assert!(err.contains("over the memory budget of 1 MB"), "{err}");
+    assert!(err.contains("--memory-budget MB allows more"), "{err}");
+    assert!(!out.exists(), "nothing written when refused");
+    let (ok, _, err) = render("0");
+    assert!(
+        !ok && err.contains("--memory-budget"),
+        "0 MB is refused by the parser: {err}"
+    );
+    let (ok, _, err) = render("100000");
+    assert!(ok, "{err}");
+    assert!(out.exists());
+}
+
 #[test]
 fn render_reports_bad_input_with_file_and_line() {
     let d = scratch("bad");

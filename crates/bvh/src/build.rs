@@ -7,7 +7,7 @@ use std::time::Instant;
 use glam::Vec3A;
 use rayon::prelude::*;
 
-use crate::geometry::{prim_refs, Aabb, Geometry, PrimRef};
+use crate::geometry::{fill_prim_refs, prim_refs, Aabb, Geometry, PrimRecord, PrimRef};
 use crate::tree::{refs_bounds, Builder, Bvh, Node, INNER, LEAF_MAX};
 
 /// Most bins the binned builder supports.
@@ -364,7 +364,12 @@ fn split(
     let (mut lcb_est, mut rcb_est) = (*cb, *cb);
     lcb_est.max[k] = plane.min(cb.max[k]);
     rcb_est.min[k] = plane.max(cb.min[k]);
-    let (lbinner, rbinner) = (Binner::new(&lcb_est, nb), Binner::new(&rcb_est, nb));
+    let nl_est: u32 = bins[k][..=pos].iter().map(|b| b.n).sum();
+    let nr_est = n as u32 - nl_est;
+    let (lbinner, rbinner) = (
+        Binner::new(&lcb_est, child_bins(nl_est as usize, nb)),
+        Binner::new(&rcb_est, child_bins(nr_est as usize, nb)),
+    );
     // The parent's bins are no longer needed: reuse their box for the left child.
     pre.binner = lbinner;
     pre.bins = [[EMPTY_BIN; MAX_BINS]; 3];
@@ -401,6 +406,13 @@ fn split(
         rcb: rcb.aabb(),
     };
     (s, Some(lpre), Some(rpre))
+}
+
+/// Bins for a child of about `count` primitives: one per 4 primitives, 4 to `nb`. The sweep
+/// over 3 × 32 bins costs as much as binning ~100 primitives, so small nodes take fewer:
+/// 740K-atom `random_molecule`, 2 threads, best of 5: 352-363 → 325-341 ms, SAH +0.4 %.
+fn child_bins(count: usize, nb: usize) -> usize {
+    (count / 4).clamp(4.min(nb), nb)
 }
 
 /// The top of the tree, built in parallel: inner nodes down to subtrees small enough to build
@@ -503,12 +515,21 @@ fn build_seq(
     }
 }
 
-/// Flattens a skeleton into one node array (root at 0, children pairs adjacent).
-fn assemble(sk: Skeleton, prims: usize) -> Vec<Node> {
-    let mut out = Vec::with_capacity(prims / 2 + 8);
+/// Flattens a skeleton into one node array (root at 0, children pairs adjacent), allocated
+/// at its exact size.
+fn assemble(sk: Skeleton) -> Vec<Node> {
+    let mut out = Vec::with_capacity(node_count(&sk));
     out.push(Node::default());
     place(sk, 0, &mut out);
     out
+}
+
+/// Nodes of the tree a skeleton flattens to.
+fn node_count(sk: &Skeleton) -> usize {
+    match sk {
+        Skeleton::Inner { children, .. } => 1 + node_count(&children.0) + node_count(&children.1),
+        Skeleton::Local(v) => v.len(),
+    }
 }
 
 fn place(sk: Skeleton, at: usize, out: &mut Vec<Node>) {
@@ -561,16 +582,22 @@ impl Bvh {
     pub fn build_with_progress(g: &Geometry, opt: &BuildOptions, done: &AtomicU64) -> Bvh {
         let start = Instant::now();
         let nb = opt.bins.clamp(2, MAX_BINS);
-        let (mut refs, bounds, cb) = prim_refs(g);
-        let n = refs.len();
+        // One 32-byte array: the builder's references first, the records written over them
+        // (the peak holds one of the two, not both).
+        let n = g.prim_count();
+        // (Zeroed by the allocator: the pages are first touched by the parallel pass that
+        // fills them, not by one thread writing defaults: 20-24 ms less at 1.56 M primitives.)
+        let mut records: Vec<PrimRecord> = bytemuck::zeroed_vec(n);
+        let refs: &mut [PrimRef] = bytemuck::cast_slice_mut(&mut records);
+        let (bounds, cb) = fill_prim_refs(g, refs);
         let nodes = if n == 0 {
             vec![Node::default()]
         } else {
-            let sk = build_skeleton(&mut refs, 0, bounds, cb, nb, None, done);
-            assemble(sk, n)
+            let sk = build_skeleton(refs, 0, bounds, cb, nb, None, done);
+            assemble(sk)
         };
         let order: Vec<u32> = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();
-        Bvh::finish(g, nodes, order, Builder::Binned, start)
+        Bvh::finish(g, nodes, order, records, Builder::Binned, start)
     }
 
     /// The paper's builder (§4.1): primitives presorted along x, y and z; each node sweeps all
@@ -584,6 +611,7 @@ impl Bvh {
             return Bvh::finish(
                 g,
                 vec![Node::default()],
+                Vec::new(),
                 Vec::new(),
                 Builder::FullSweep,
                 start,
@@ -610,7 +638,9 @@ impl Bvh {
         };
         st.build([&mut lx, &mut ly, &mut lz], 0);
         let Sweep { nodes, order, .. } = st;
-        Bvh::finish(g, nodes, order, Builder::FullSweep, start)
+        drop(refs);
+        let records = vec![PrimRecord::default(); order.len()];
+        Bvh::finish(g, nodes, order, records, Builder::FullSweep, start)
     }
 }
 

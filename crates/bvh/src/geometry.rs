@@ -218,25 +218,34 @@ impl Geometry {
         bonds: &[[u32; 2]],
         stick_radius: f32,
     ) -> Geometry {
-        let n = x.len();
+        let balls = Balls {
+            x: x.to_vec(),
+            y: y.to_vec(),
+            z: z.to_vec(),
+            radius: radius.to_vec(),
+            color: color.to_vec(),
+        };
+        Geometry::from_balls(balls, bonds, stick_radius)
+    }
+
+    /// [`Geometry::from_atoms`] taking the atoms' arrays over instead of copying them.
+    pub fn from_balls(balls: Balls, bonds: &[[u32; 2]], stick_radius: f32) -> Geometry {
+        let n = balls.x.len();
         assert!(
-            y.len() == n && z.len() == n && radius.len() == n,
+            balls.y.len() == n && balls.z.len() == n && balls.radius.len() == n,
             "x, y, z and radius must have one entry per atom"
         );
-        assert!(color.is_empty() || color.len() == n, "one colour per atom");
+        assert!(
+            balls.color.is_empty() || balls.color.len() == n,
+            "one colour per atom"
+        );
         let (a, b): (Vec<u32>, Vec<u32>) = bonds
             .iter()
             .filter(|p| (p[0] as usize) < n && (p[1] as usize) < n)
             .map(|p| (p[0], p[1]))
             .unzip();
         Geometry {
-            balls: Balls {
-                x: x.to_vec(),
-                y: y.to_vec(),
-                z: z.to_vec(),
-                radius: radius.to_vec(),
-                color: color.to_vec(),
-            },
+            balls,
             sticks: Sticks {
                 a,
                 b,
@@ -389,8 +398,10 @@ impl Geometry {
 
 /// Primitive bounds, as the builders see them: two SSE-friendly vectors, the primitive id
 /// tagged into both `w` lanes (as a normal/inf/NaN float, never a denormal, so arithmetic on
-/// the whole vector never hits slow paths).
-#[derive(Clone, Copy, Debug)]
+/// the whole vector never hits slow paths). 32 bytes, as a [`PrimRecord`]: the binned
+/// builder works on its record array viewed as references and writes the records over them.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub(crate) struct PrimRef {
     pub lo: Vec4,
     pub hi: Vec4,
@@ -444,12 +455,19 @@ impl PrimRef {
 /// Bounds and centroids of every primitive, with the global bounds and the centroid bounds,
 /// in one parallel pass (paper §4.1 step 3). Centroids are kept doubled (`lo + hi`).
 pub(crate) fn prim_refs(g: &Geometry) -> (Vec<PrimRef>, Aabb, Aabb) {
+    let mut refs = vec![PrimRef::new(&Aabb::EMPTY, 0); g.prim_count()];
+    let (bounds, cbounds) = fill_prim_refs(g, &mut refs);
+    (refs, bounds, cbounds)
+}
+
+/// [`prim_refs`] into `refs` (one per primitive of `g`); returns the bounds and the centroid
+/// bounds.
+pub(crate) fn fill_prim_refs(g: &Geometry, refs: &mut [PrimRef]) -> (Aabb, Aabb) {
     const CHUNK: usize = 1 << 13;
     let n = g.prim_count();
     assert!(n < MAX_PRIMS, "{n} primitives: at most 2^30 supported");
-    let mut refs = vec![PrimRef::new(&Aabb::EMPTY, 0); n];
-    let (bounds, cbounds) = refs
-        .par_chunks_mut(CHUNK)
+    assert_eq!(refs.len(), n, "one reference per primitive");
+    refs.par_chunks_mut(CHUNK)
         .enumerate()
         .map(|(ci, chunk)| {
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
@@ -477,6 +495,5 @@ pub(crate) fn prim_refs(g: &Geometry) -> (Vec<PrimRef>, Aabb, Aabb) {
         .reduce(
             || (Aabb::EMPTY, Aabb::EMPTY),
             |a, b| (a.0.union(b.0), a.1.union(b.1)),
-        );
-    (refs, bounds, cbounds)
+        )
 }

@@ -136,19 +136,23 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Assembles the tree from builder output: `order[slot]` is the primitive in that slot.
+    /// Assembles the tree from builder output: `order[slot]` is the primitive in that slot;
+    /// its record is written into `records[slot]` (an array of the same length whose old
+    /// contents are no longer needed, e.g. the builder's references).
     pub(crate) fn finish(
         g: &Geometry,
         nodes: Vec<Node>,
         order: Vec<u32>,
+        mut records: Vec<PrimRecord>,
         builder: Builder,
         start: std::time::Instant,
     ) -> Bvh {
-        let records: Vec<PrimRecord> = order
-            .par_iter()
+        assert_eq!(records.len(), order.len(), "one record per slot");
+        records
+            .par_iter_mut()
+            .zip(order.par_iter())
             .with_min_len(4096)
-            .map(|&id| g.record(id))
-            .collect();
+            .for_each(|(r, &id)| *r = g.record(id));
         let bounds = nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
         let build_time = start.elapsed();
         let (leaves, max_depth, sah_cost) = tree_figures(&nodes);

@@ -109,6 +109,9 @@ pub struct Look {
     pub macrocells: bool,
     /// Volume: pre-integrated classification (else post-classification).
     pub preintegrated: bool,
+    /// Most bytes the scene build may allocate (its estimated peak, checked before anything
+    /// large is allocated); `None`: 75 % of the memory available when the build starts.
+    pub memory_budget: Option<u64>,
 }
 
 impl Default for Look {
@@ -141,6 +144,7 @@ impl Default for Look {
             bounces: r.bounces,
             macrocells: true,
             preintegrated: true,
+            memory_budget: None,
         }
     }
 }
@@ -265,7 +269,7 @@ impl Look {
                 light_volume,
                 ..self.volume.clone()
             }),
-            budget_bytes: None,
+            budget_bytes: self.memory_budget,
             frame: Some(frame),
         }
     }

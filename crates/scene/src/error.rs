@@ -46,7 +46,10 @@ pub enum SceneError {
     #[error("no atoms to build a scene of")]
     NoAtoms,
     /// The estimate exceeds the memory budget (checked before anything large is allocated).
-    #[error("the scene would need about {} MB ({}), over the memory budget of {} MB",
+    #[error("the scene would need about {} MB ({}), over the memory budget of {} MB; \
+        fewer atoms, --style spheres (no sticks) or a coarser --voxels-per-angstrom need \
+        less, and --memory-budget MB allows more (the default is 75 % of the memory \
+        available)",
         needed / 1_000_000, breakdown, budget / 1_000_000)]
     TooLarge {
         /// Estimated bytes still to allocate: [`crate::MemoryEstimate::peak_bytes`] less the

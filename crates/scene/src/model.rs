@@ -3,7 +3,7 @@
 use std::sync::atomic::AtomicU64;
 use std::sync::OnceLock;
 
-use bvh::{BuildOptions, Bvh, Geometry, Prim, WideBvh};
+use bvh::{Balls, BuildOptions, Bvh, Geometry, Prim, WideBvh};
 use rayon::prelude::*;
 
 use molecule::Cell;
@@ -157,7 +157,16 @@ impl Model {
         } else {
             bonds
         };
-        let mut g = Geometry::from_atoms(x, y, z, &radii, &colors, bonds, opt.stick_radius);
+        // The scaled radii and the colours become the balls' own arrays (moved, not copied:
+        // 8 B per atom less at the peak of the model build).
+        let balls = Balls {
+            x: x.to_vec(),
+            y: y.to_vec(),
+            z: z.to_vec(),
+            radius: radii,
+            color: colors,
+        };
+        let mut g = Geometry::from_balls(balls, bonds, opt.stick_radius);
         g.show_balls = opt.style != Style::Licorice;
         g.capped = opt.style == Style::Licorice;
         if let Some(cell) = &opt.cell {

@@ -411,7 +411,7 @@ pub fn half_bits(x: f32) -> u16 {
         return (x as f64 * 16_777_216.0).round_ties_even() as u16;
     }
     let b = x.to_bits();
-    let e = (b >> 23) - 127 + 15;
+    let e = (b >> 23) + 15 - 127; // ≥ 1: x ≥ 2⁻¹⁴ here (no u32 underflow)
     let (q, r) = ((b & 0x7f_ffff) >> 13, b & 0x1fff);
     let up = r > 0x1000 || (r == 0x1000 && q & 1 == 1);
     (e << 10 | q) as u16 + up as u16

@@ -21,6 +21,7 @@ mod intersect;
 mod query;
 #[cfg(any(test, feature = "testing"))]
 pub mod scenes;
+mod spans;
 mod traverse;
 mod tree;
 mod wide;
@@ -31,6 +32,7 @@ pub use intersect::{
     end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,
 };
 pub use query::{Query, Stacks, Traversal};
+pub use spans::Span;
 pub use traverse::{
     box_test, load_packet, slab_test, unpack_hits, Hit, PacketHit, Ray, RayPacket, BOX_GROW,
 };

@@ -33,13 +33,13 @@ use crate::tf::ClassifiedTf;
 /// tables): exponent and mantissa moved into place, then rebiased by 2¹¹² (exact, subnormals
 /// included).
 #[inline(always)]
-fn half_lo<S: Simd>(s: S, w: S::I32) -> S::F32 {
+pub(crate) fn half_lo<S: Simd>(s: S, w: S::I32) -> S::F32 {
     s.bitcast_f(s.shl(w, 13) & s.splat_i(0x0fff_e000)) * s.splat(f32::from_bits(0x7780_0000))
 }
 
 /// As [`half_lo`] for bits 16-31.
 #[inline(always)]
-fn half_hi<S: Simd>(s: S, w: S::I32) -> S::F32 {
+pub(crate) fn half_hi<S: Simd>(s: S, w: S::I32) -> S::F32 {
     s.bitcast_f(s.shr(w, 3) & s.splat_i(0x0fff_e000)) * s.splat(f32::from_bits(0x7780_0000))
 }
 
@@ -352,7 +352,7 @@ impl Rays<'_> {
 
 /// Lanes `i..` of three SoA slices (zeros past their end).
 #[inline(always)]
-fn load3<S: Simd>(s: S, a: [&[f32]; 3], i: usize) -> V3<S> {
+pub(crate) fn load3<S: Simd>(s: S, a: [&[f32]; 3], i: usize) -> V3<S> {
     V3::<S>::new(
         s.load_partial(&a[0][i..], 0.0),
         s.load_partial(&a[1][i..], 0.0),

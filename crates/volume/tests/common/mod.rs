@@ -1,6 +1,9 @@
 //! Shared test helpers: a deterministic RNG, synthetic atom sets and an f64 brute-force Φ.
 #![allow(dead_code)]
 
+mod rays;
+pub use rays::*;
+
 /// SplitMix64: deterministic, independent of any crate.
 pub struct Rng(pub u64);
 impl Rng {

@@ -1,0 +1,390 @@
+//! Ray marching through a grid-free RBF volume ([`crate::particles`]; Knoll et al. 2014): per
+//! ray, the BVH lists the support spheres it crosses, sorted by entry; samples lie where the
+//! grid path's would (`t_k = t_in + k·Δt` over the same box, Δt = the step of the classified
+//! transfer function in voxels of [`Particles::grid`]); each sample sums the Gaussians of the
+//! spheres active there, `S::LANES` consecutive samples at a time (SIMD along the ray, one
+//! ray after another). Stretches where no sphere is active and the transfer function makes
+//! zero density transparent are skipped, as the grid path skips empty macrocells.
+//! Classification (pre-integrated or post), lighting (the analytic gradient of Φ instead of
+//! central differences), compositing, the opacity cut-off and the opaque depth `tmax` are the
+//! grid path's. Volumetric shadows need the grid (they march the density towards the light
+//! from every sample) and are refused by [`ParticleScene::new`].
+
+use std::cell::RefCell;
+
+use bvh::Span;
+use spmd::{Isa, Kernel, Simd, V3};
+
+use crate::march::{half_hi, half_lo, load3, Rays};
+use crate::particles::Particles;
+use crate::sampler::{bin, clip_box, GridRay};
+use crate::scene::{Light, Lighting, MarchOptions};
+use crate::tf::ClassifiedTf;
+
+/// Everything the particle marcher reads. Cheap to create per frame.
+#[derive(Clone, Copy, Debug)]
+pub struct ParticleScene<'a> {
+    /// The atoms and their BVH.
+    pub particles: &'a Particles,
+    /// The classified transfer function (its `step_voxels` sets the step).
+    pub tf: &'a ClassifiedTf,
+    /// Options (`macrocells` switches empty-space skipping; `shadows` must be `None`).
+    pub opts: MarchOptions,
+}
+
+impl<'a> ParticleScene<'a> {
+    /// Bundles the parts. Panics if `opts.shadows` is set: volumetric shadows need the grid.
+    pub fn new(particles: &'a Particles, tf: &'a ClassifiedTf, opts: MarchOptions) -> Self {
+        assert!(
+            opts.shadows.is_none(),
+            "ParticleScene: volumetric shadows need the density grid"
+        );
+        ParticleScene {
+            particles,
+            tf,
+            opts,
+        }
+    }
+}
+
+/// The spheres active over a stretch of one ray, structure of arrays: what each sample sums.
+#[derive(Default)]
+struct Active {
+    /// Ray origin minus centre (Å), per axis.
+    ox: Vec<f32>,
+    oy: Vec<f32>,
+    oz: Vec<f32>,
+    /// −1/rᵢ².
+    nir2: Vec<f32>,
+    /// √rᵢ.
+    amp: Vec<f32>,
+    /// 2·rᵢ², the squared support radius.
+    cut2: Vec<f32>,
+    /// Where the ray leaves the support sphere.
+    t1: Vec<f32>,
+}
+
+impl Active {
+    fn columns(&mut self) -> [&mut Vec<f32>; 7] {
+        [
+            &mut self.ox,
+            &mut self.oy,
+            &mut self.oz,
+            &mut self.nir2,
+            &mut self.amp,
+            &mut self.cut2,
+            &mut self.t1,
+        ]
+    }
+
+    fn clear(&mut self) {
+        self.columns().into_iter().for_each(Vec::clear);
+    }
+
+    fn push(&mut self, o: [f32; 3], c: [f32; 3], r: f32, t1: f32) {
+        self.ox.push(o[0] - c[0]);
+        self.oy.push(o[1] - c[1]);
+        self.oz.push(o[2] - c[2]);
+        self.nir2.push(-1.0 / (r * r));
+        self.amp.push(r.sqrt());
+        self.cut2.push(2.0 * r * r);
+        self.t1.push(t1);
+    }
+
+    /// Drops the spheres the ray has left before `t`.
+    fn retire(&mut self, t: f32) {
+        let mut i = 0;
+        while i < self.t1.len() {
+            if self.t1[i] < t {
+                for v in self.columns() {
+                    v.swap_remove(i);
+                }
+            } else {
+                i += 1;
+            }
+        }
+    }
+}
+
+/// Per-thread scratch of the marcher (reused across rays and frames).
+#[derive(Default)]
+struct Scratch {
+    stack: Vec<u32>,
+    spans: Vec<Span>,
+    active: Active,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Packet entry point, as [`crate::march()`]: marches `S::LANES` rays (world space, Å; `t`
+/// in units of `|dir|`) from `t = 0` to `min(box exit, tmax)`, one lane after another.
+/// Inactive lanes return zeros. Returns premultiplied `[r, g, b, a]`.
+#[inline(always)]
+pub fn march_particles<S: Simd>(
+    s: S,
+    scene: &ParticleScene,
+    orig: V3<S>,
+    dir: V3<S>,
+    tmax: S::F32,
+    active: S::M,
+) -> [S::F32; 4] {
+    let g = &scene.particles.grid;
+    let hi = g.dims.map(|n| (n - 1) as f32);
+    let ray = GridRay::from_world(s, g, orig, dir);
+    let span = clip_box(s, &ray, hi, tmax, scene.tf.step_voxels, active);
+    let mut out = [[0.0f32; spmd::MAX_LANES]; 4];
+    let mut bits = s.bitmask(span.alive);
+    if bits != 0 {
+        SCRATCH.with(|sc| {
+            let sc = &mut *sc.borrow_mut();
+            while bits != 0 {
+                let l = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let e = |v: V3<S>| [s.extract(v.x, l), s.extract(v.y, l), s.extract(v.z, l)];
+                let t = [s.extract(span.t_in, l), s.extract(span.t_end, l)];
+                let c = march_ray(s, scene, e(orig), e(dir), t, s.extract(span.dt, l), sc);
+                for ch in 0..4 {
+                    out[ch][l] = c[ch];
+                }
+            }
+        });
+    }
+    [
+        s.load(&out[0]),
+        s.load(&out[1]),
+        s.load(&out[2]),
+        s.load(&out[3]),
+    ]
+}
+
+// Knoll et al. 2014 on the paper's §4.4 compositing: one ray, `t` from `t_in` to `t_end`
+// in steps `dt`, sphere lists from the BVH, LANES samples at a time.
+#[inline(always)]
+fn march_ray<S: Simd>(
+    s: S,
+    scene: &ParticleScene,
+    o: [f32; 3],
+    d: [f32; 3],
+    [t_in, t_end]: [f32; 2],
+    dt: f32,
+    sc: &mut Scratch,
+) -> [f32; 4] {
+    let p = scene.particles;
+    let tf = scene.tf;
+    let opts = &scene.opts;
+    if sc.stack.len() < p.bvh.stack_size() {
+        sc.stack.resize(p.bvh.stack_size(), 0);
+    }
+    sc.spans.clear();
+    p.bvh
+        .sphere_spans(o, d, t_in, t_end, &mut sc.stack, &mut sc.spans);
+    sc.spans.sort_unstable_by(|a, b| a.t0.total_cmp(&b.t0));
+    let act = &mut sc.active;
+    act.clear();
+    let b0 = tf.bin(0.0);
+    let skip = opts.macrocells && tf.range_max[b0 * 256 + b0] == 0.0;
+    let lit = opts.lighting != Lighting::Unlit;
+    let light = match opts.lighting {
+        Lighting::Directional(l) => Some(Light::Directional(l)),
+        Lighting::Point(q) => Some(Light::Point(q)),
+        _ => None,
+    };
+    let dv = V3::<S>::splat(s, d);
+    let ov = V3::<S>::splat(s, o);
+    let headlight = -dv.normalize(s);
+    let lanes = s.to_f32(s.lane_index());
+    let w = S::LANES;
+    let mut acc = [0.0f32; 4];
+    // Values at points j−1 … j+LANES−1 of the current chunk: [0] is the previous point's.
+    let mut vals = [0.0f32; spmd::MAX_LANES + 1];
+    let mut rgba = [[0.0f32; spmd::MAX_LANES]; 4];
+    let mut next = 0usize;
+    let mut j = 0usize;
+    loop {
+        // Point j is at t_in + j·dt; the segment ending there starts at point j − 1.
+        if j > 0 && t_in + (j - 1) as f32 * dt >= t_end {
+            break;
+        }
+        // (Clamped as the points are: a sphere cut by t_end still reaches the last one.)
+        let tj = (t_in + j as f32 * dt).min(t_end);
+        act.retire(tj);
+        if skip && act.t1.is_empty() && (j == 0 || vals[0] == 0.0) {
+            // Nothing reaches point j: jump to the last point before the next sphere.
+            let Some(sp) = sc.spans.get(next) else { break };
+            let q = ((sp.t0 - t_in) / dt).floor();
+            if q > j as f32 {
+                j = q as usize;
+                vals[0] = 0.0;
+                continue;
+            }
+        }
+        let t_last = (t_in + (j + w - 1) as f32 * dt).min(t_end);
+        while let Some(sp) = sc.spans.get(next).filter(|sp| sp.t0 <= t_last) {
+            let slot = sp.slot as usize;
+            act.push(o, p.bvh.records[slot].p0, p.radius[slot], sp.t1);
+            next += 1;
+        }
+        // Φ (and ∇Φ when lit) at points j … j+LANES−1.
+        let kv = s.splat(j as f32) + lanes;
+        let t = s.min(s.splat(t_in) + kv * s.splat(dt), s.splat(t_end));
+        let (val, grad) = density_at(s, act, dv, t, lit);
+        s.store(val, &mut vals[1..]);
+        // Segment ending at point j + l is valid when it starts before t_end.
+        let t_front = s.splat(t_in) + (kv - s.splat(1.0)) * s.splat(dt);
+        let valid = s.gt(kv, s.splat(0.0)) & s.lt(t_front, s.splat(t_end));
+        let frac = (t - t_front) * s.splat(1.0 / dt);
+        let front = s.load(&vals[..w]);
+        let mut c = classify(s, tf, front, val, valid, opts.preintegrated);
+        if lit {
+            let shading = valid & s.gt(c[3], s.splat(0.0));
+            if s.any(shading) {
+                let l = match light {
+                    Some(light) => light.towards(s, ov.mul_add(dv, t)).0,
+                    None => headlight,
+                };
+                let len2 = grad.dot(grad);
+                let ok = s.gt(len2, s.splat(1e-20));
+                let one = s.splat(1.0);
+                let ndotl = s.abs(grad.dot(l)) * s.rsqrt(s.select(ok, len2, one));
+                let f = s.select(ok, s.min(ndotl, one), one);
+                let ambient = s.splat(opts.ambient);
+                let shade = ambient + (one - ambient) * f;
+                for ch in c.iter_mut().take(3) {
+                    *ch = s.select(shading, *ch * shade, *ch);
+                }
+            }
+        }
+        for (ch, v) in c.into_iter().enumerate() {
+            s.store(v * frac, &mut rgba[ch]);
+        }
+        // Front to back, one segment after another.
+        let nvalid = s.bitmask(valid);
+        for l in 0..w {
+            if nvalid & (1 << l) == 0 {
+                continue;
+            }
+            let wgt = 1.0 - acc[3];
+            for ch in 0..4 {
+                acc[ch] += wgt * rgba[ch][l];
+            }
+            if acc[3] >= opts.opacity_cutoff {
+                return acc;
+            }
+        }
+        if nvalid == 0 && j > 0 {
+            break;
+        }
+        vals[0] = vals[w];
+        j += w;
+    }
+    acc
+}
+
+// RBF density (paper §3.1) at points `o + t·d` of one ray: Φ = Σ √rᵢ·exp(−|x − cᵢ|²/rᵢ²) over
+// the active spheres with |x − cᵢ|² < 2rᵢ², and, when `lit`, its gradient
+// ∇Φ = Σ −2/rᵢ² · √rᵢ·exp(…) · (x − cᵢ).
+#[inline(always)]
+fn density_at<S: Simd>(s: S, act: &Active, d: V3<S>, t: S::F32, lit: bool) -> (S::F32, V3<S>) {
+    let zero = s.splat(0.0);
+    let mut val = zero;
+    let mut grad = V3::<S>::splat(s, [0.0; 3]);
+    for i in 0..act.t1.len() {
+        let oc = V3::<S>::new(s.splat(act.ox[i]), s.splat(act.oy[i]), s.splat(act.oz[i]));
+        let x = oc.mul_add(d, t);
+        let d2 = x.dot(x);
+        let nir2 = s.splat(act.nir2[i]);
+        let inside = s.lt(d2, s.splat(act.cut2[i]));
+        let g = s.select(
+            inside,
+            s.splat(act.amp[i]) * spmd::math::exp(s, d2 * nir2),
+            zero,
+        );
+        val += g;
+        if lit {
+            grad = grad + x.scale(g * nir2 * s.splat(2.0));
+        }
+    }
+    (val, grad)
+}
+
+// Paper §4.4: segment colour and opacity from the pre-integration table (front, back values)
+// or the post-classification table (back value), as the grid marcher reads them.
+#[inline(always)]
+fn classify<S: Simd>(
+    s: S,
+    tf: &ClassifiedTf,
+    front: S::F32,
+    back: S::F32,
+    m: S::M,
+    preint: bool,
+) -> [S::F32; 4] {
+    if preint {
+        let idx = s.shl(s.shl(bin(s, tf, front), 8) + bin(s, tf, back), 1);
+        let rg = s.gather_i(&tf.preint_half, idx, m, s.splat_i(0));
+        let ba = s.gather_i(&tf.preint_half, idx + s.splat_i(1), m, s.splat_i(0));
+        [
+            half_lo(s, rg),
+            half_hi(s, rg),
+            half_lo(s, ba),
+            half_hi(s, ba),
+        ]
+    } else {
+        let idx = s.shl(bin(s, tf, back), 2);
+        let zero = s.splat(0.0);
+        [
+            s.gather(&tf.post, idx, m, zero),
+            s.gather(&tf.post, idx + s.splat_i(1), m, zero),
+            s.gather(&tf.post, idx + s.splat_i(2), m, zero),
+            s.gather(&tf.post, idx + s.splat_i(3), m, zero),
+        ]
+    }
+}
+
+struct ParticleBatch<'a, 'b> {
+    scene: &'a ParticleScene<'a>,
+    rays: &'a Rays<'a>,
+    out: &'b mut [[f32; 4]],
+}
+
+impl Kernel for ParticleBatch<'_, '_> {
+    type Output = ();
+    // A batch of rays, LANES at a time, through `march_particles`.
+    #[inline(always)]
+    fn run<S: Simd>(self, s: S) {
+        let n = self.rays.len();
+        let r = self.rays;
+        let mut buf = [0.0f32; spmd::MAX_LANES];
+        let mut i = 0;
+        while i < n {
+            let orig = load3(s, r.origin, i);
+            let dir = load3(s, r.dir, i);
+            let tmax = s.load_partial(&r.tmax[i..], 0.0);
+            let c = march_particles(s, self.scene, orig, dir, tmax, s.first_n(n - i));
+            let cnt = (n - i).min(S::LANES);
+            for (ch, v) in c.into_iter().enumerate() {
+                s.store(v, &mut buf);
+                for (o, b) in self.out[i..i + cnt].iter_mut().zip(buf) {
+                    o[ch] = b;
+                }
+            }
+            i += S::LANES;
+        }
+    }
+}
+
+/// Marches every ray of `rays` through `scene` with backend `isa`, as [`crate::march_rays`]
+/// does through a grid. Panics if the slices' lengths differ.
+pub fn march_particle_rays(isa: Isa, scene: &ParticleScene, rays: &Rays, out: &mut [[f32; 4]]) {
+    let n = rays.len();
+    assert!(
+        rays.origin
+            .iter()
+            .chain(rays.dir.iter())
+            .all(|a| a.len() == n)
+            && out.len() == n,
+        "march_particle_rays: ray and output slices must have equal lengths"
+    );
+    isa.dispatch(ParticleBatch { scene, rays, out });
+}

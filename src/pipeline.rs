@@ -4,7 +4,7 @@
 use clap::Args;
 use render::{Colormap, Style};
 use scene::text::parse_range;
-use scene::{ColorBy, ModelSettings, RadiusKind, VolumeSettings};
+use scene::{ColorBy, DensitySource, ModelSettings, RadiusKind, VolumeSettings};
 use volume::VolumeFormat;
 
 /// Geometry options of the ball-and-stick scene.
@@ -47,7 +47,13 @@ pub struct GeometryArgs {
 #[derive(Args, Debug, Clone)]
 #[command(next_help_heading = "Volume")]
 pub struct VolumeArgs {
+    /// Where the RBF density comes from: grid (sampled once, interpolated; memory grows with
+    /// the voxels) or particles (summed from the atoms at every sample through a BVH; exact,
+    /// memory grows with the atoms, no --volume-shadows).
+    #[arg(long = "volume", value_enum, default_value = "grid")]
+    pub source: DensitySource,
     /// Density grid resolution (voxels per Å; the paper uses 4, and 1 for sio2 and anp3).
+    /// The step is half a voxel, with --volume particles too.
     #[arg(long, default_value_t = 4.0)]
     pub voxels_per_angstrom: f32,
     /// Voxel storage: u8 (quantised, one global scale) or f32.
@@ -97,6 +103,7 @@ impl VolumeArgs {
             .parse()
             .map_err(|e| anyhow::anyhow!("--volume-format: {e}"))?;
         Ok(VolumeSettings {
+            source: self.source,
             voxels_per_angstrom: self.voxels_per_angstrom,
             format,
             density_max: self.density_max,

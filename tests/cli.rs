@@ -271,6 +271,58 @@ fn memory_budget_refuses_with_the_way_out_and_allows_what_fits() {
     assert!(out.exists());
 }
 
+/// `--volume particles`: the grid-free volume renders the picture the f32 grid does (same
+/// camera, transfer function range and step; the grid's interpolation is the difference),
+/// says so under -v, and refuses volumetric shadows with the way out.
+#[test]
+fn grid_free_volume_renders_the_grid_picture_and_refuses_shadows() {
+    let d = scratch("particles");
+    let render = |source: &str, name: &str, extra: &[&str]| {
+        let out = d.join(name);
+        let r = run(bnsview()
+            .args([
+                "render", "--scene", "nanobowl", "--size", "96x72", "--mode", "volume",
+            ])
+            .args([
+                "--volume",
+                source,
+                "--volume-format",
+                "f32",
+                "--density-max",
+                "1.1",
+            ])
+            .args(extra)
+            .arg("-v")
+            .arg("-o")
+            .arg(&out));
+        (r, out)
+    };
+    let ((ok, _, err), part) = render("particles", "p.png", &[]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("grid-free"),
+        "-v names the grid-free volume: {err}"
+    );
+    let ((ok, _, err), grid) = render("grid", "g.png", &[]);
+    assert!(ok, "{err}");
+    let (a, b) = (
+        image::open(&part).unwrap().to_rgb8(),
+        image::open(&grid).unwrap().to_rgb8(),
+    );
+    let diffs: Vec<u8> = a
+        .pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap())
+        .collect();
+    let mean = diffs.iter().map(|&v| v as f64).sum::<f64>() / diffs.len() as f64;
+    let lit = a.pixels().filter(|p| p.0.iter().any(|&c| c > 40)).count();
+    assert!(lit * 4 > diffs.len(), "the bowl covers the frame: {lit}");
+    assert!(mean < 4.0, "mean difference {mean}");
+    let ((ok, _, err), shadowed) = render("particles", "s.png", &["--volume-shadows"]);
+    assert!(!ok && err.contains("--volume grid"), "{err}");
+    assert!(!shadowed.exists());
+}
+
 #[test]
 fn render_reports_bad_input_with_file_and_line() {
     let d = scratch("bad");

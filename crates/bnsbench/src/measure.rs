@@ -9,7 +9,7 @@ use molecule::scenes::{try_generate, SceneName};
 use render::{render_frame, Camera, FrameInputs, Framebuffer, RenderSettings, View};
 use scene::{ball_sphere, BondSettings, Model, Sphere, VolumeSettings, LIGHT_VOLUME_STRIDE};
 use spmd::Isa;
-use volume::{ClassifiedTf, LightVolume, MarchOptions, VolumeFormat, VolumeScene};
+use volume::{ClassifiedTf, LightVolume, MarchOptions, Medium, VolumeFormat, VolumeScene};
 
 use crate::error::BenchError;
 use crate::mode::BenchMode;
@@ -228,7 +228,8 @@ impl Session<'_> {
             let vs = match (vs, light) {
                 (Some(v), Some(l)) => Some(v.with_light_volume(l)),
                 (v, _) => v,
-            };
+            }
+            .map(Medium::Grid);
             let inputs = FrameInputs {
                 model: model.as_ref().filter(|_| key.mode.geometry()),
                 volume: vs.as_ref(),

@@ -8,9 +8,9 @@ use crate::tree::Bvh;
 /// ray's direction vector).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
-    /// Entry parameter (clipped to the query's `t_lo`).
+    /// Entry parameter.
     pub t0: f32,
-    /// Exit parameter (clipped to the query's `t_hi`).
+    /// Exit parameter.
     pub t1: f32,
     /// Slot in [`Bvh::records`] / [`Bvh::prim_ids`].
     pub slot: u32,
@@ -22,8 +22,10 @@ const WIDEN: f32 = 1e-4;
 
 impl Bvh {
     /// Appends to `out` every sphere (ball primitive; sticks are skipped) that the ray
-    /// `o + t·d` passes through for some `t` in `[t_lo, t_hi]`, with its chord clipped to that
-    /// range and widened by 10⁻⁴ of the sphere's radius each way. `d` need not be unit; `t`
+    /// `o + t·d` passes through for some `t` in `[t_lo, t_hi]`, with its whole chord (not
+    /// clipped to the range, so a caller walking the ray in windows can tell the spheres it
+    /// has already met: those entered before the window) widened by 10⁻⁴ of the sphere's
+    /// radius each way. `d` need not be unit; `t`
     /// is in units of it. Spans come in traversal order, not sorted. A zero, NaN or infinite
     /// `d` or `o`, or an empty range, gives none. `stack` must hold [`Bvh::stack_size`]
     /// entries.
@@ -57,8 +59,7 @@ impl Bvh {
                             continue;
                         }
                         if let Some((t0, t1)) = chord(o, d, dd, rec.p0, rec.r) {
-                            let (t0, t1) = (t0.max(t_lo), t1.min(t_hi));
-                            if t0 <= t1 {
+                            if t0 <= t_hi && t1 >= t_lo {
                                 out.push(Span {
                                     t0,
                                     t1,
@@ -108,7 +109,7 @@ fn slab_overlap(
 /// widened by `WIDEN·r`; `None` if the ray passes outside. Closest approach first, so the
 /// perpendicular distance carries no cancellation from a far origin.
 #[inline(always)]
-fn chord(o: [f32; 3], d: [f32; 3], dd: f32, c: [f32; 3], r: f32) -> Option<(f32, f32)> {
+pub(crate) fn chord(o: [f32; 3], d: [f32; 3], dd: f32, c: [f32; 3], r: f32) -> Option<(f32, f32)> {
     let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
     let tc = -(oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2]) / dd;
     let p = [oc[0] + tc * d[0], oc[1] + tc * d[1], oc[2] + tc * d[2]];

@@ -13,6 +13,7 @@
 //! "Wide BVH: SAH collapse".)
 
 mod plan;
+mod spans;
 
 use spmd::{Scalar, Simd, V3};
 
@@ -126,6 +127,12 @@ impl WideBvh {
     /// Stack entries a query needs (each popped node pushes at most [`WIDTH`]).
     pub fn stack_size(&self) -> usize {
         (WIDTH - 1) * (self.depth + 1) + 2
+    }
+
+    /// Stack entries [`WideBvh::sphere_spans`] needs (a leaf's entry takes two words, so a
+    /// popped node pushes at most 2·[`WIDTH`]).
+    pub fn spans_stack_size(&self) -> usize {
+        (2 * WIDTH - 1) * (self.depth + 1) + 2
     }
 
     /// Bytes of the wide nodes.

@@ -3,9 +3,11 @@
 //! queries and degenerate rays.
 
 use bvh::scenes::{random_molecule, Rng};
-use bvh::{Bvh, Span};
+use bvh::{Bvh, Span, WideBvh};
+use spmd::{Isa, Kernel, Simd};
 
-/// Chord of the ray through sphere `i` with its radius times `k`, in f64, clipped to `[lo, hi]`.
+/// Chord of the ray through sphere `i` with its radius times `k`, in f64, if it overlaps
+/// `[lo, hi]`.
 fn brute(
     g: &bvh::Geometry,
     o: [f64; 3],
@@ -27,8 +29,30 @@ fn brute(
         return None;
     }
     let h = (h2 / dd).sqrt();
-    let (t0, t1) = ((tc - h).max(lo), (tc + h).min(hi));
-    (t0 <= t1).then_some((t0, t1))
+    let (t0, t1) = (tc - h, tc + h);
+    (t0 <= hi && t1 >= lo).then_some((t0, t1))
+}
+
+/// `WideBvh::sphere_spans` of one ray on a backend.
+struct WideSpans<'a> {
+    bvh: &'a Bvh,
+    wide: &'a WideBvh,
+    o: [f32; 3],
+    d: [f32; 3],
+    lo: f32,
+    hi: f32,
+}
+
+impl Kernel for WideSpans<'_> {
+    type Output = Vec<Span>;
+    fn run<S: Simd>(self, s: S) -> Vec<Span> {
+        let mut stack = vec![0u32; self.wide.spans_stack_size()];
+        let mut out = Vec::new();
+        self.wide.sphere_spans(
+            s, self.bvh, self.o, self.d, self.lo, self.hi, &mut stack, &mut out,
+        );
+        out
+    }
 }
 
 #[test]
@@ -40,6 +64,8 @@ fn spans_match_brute_force() {
         g.balls.radius.iter_mut().for_each(|r| *r *= 3.0);
         let bvh = Bvh::build(&g);
         bvh.validate(&g).unwrap();
+        let wide = WideBvh::new(&bvh);
+        wide.validate(&bvh, &g).unwrap();
         let lo_b = bvh.bounds.min;
         let hi_b = bvh.bounds.max;
         let mut rng = Rng(seed + 100);
@@ -62,6 +88,21 @@ fn spans_match_brute_force() {
             let (of, df) = (o.map(|v| v as f32), d.map(|v| v as f32));
             out.clear();
             bvh.sphere_spans(of, df, lo as f32, hi as f32, &mut stack, &mut out);
+            // The 8-wide tree lists the same spans, on every backend.
+            let mut by_slot = out.clone();
+            by_slot.sort_by_key(|s| s.slot);
+            for isa in Isa::supported() {
+                let mut w = isa.dispatch(WideSpans {
+                    bvh: &bvh,
+                    wide: &wide,
+                    o: of,
+                    d: df,
+                    lo: lo as f32,
+                    hi: hi as f32,
+                });
+                w.sort_by_key(|s| s.slot);
+                assert_eq!(w, by_slot, "{isa} ray {k}: wide spans differ");
+            }
             let mut slots: Vec<u32> = out.iter().map(|s| s.slot).collect();
             slots.sort_unstable();
             assert!(
@@ -102,8 +143,8 @@ fn spans_match_brute_force() {
                     ),
                     (Some((t0, t1)), None) => {
                         assert!(
-                            t1 - t0 <= tol,
-                            "ray {k} sphere {id}: missed a chord {t0}..{t1}"
+                            t1.min(hi) - t0.max(lo) <= tol,
+                            "ray {k} sphere {id}: missed a chord {t0}..{t1} in [{lo}, {hi}]"
                         )
                     }
                 }
@@ -132,9 +173,24 @@ fn degenerate_rays_and_empty_ranges_give_nothing() {
         (c, [1.0, 0.0, 0.0], 1.0, 0.0),
         (c, [1.0, 0.0, 0.0], f32::NAN, 1.0),
     ];
+    let wide = WideBvh::new(&bvh);
     for (o, d, lo, hi) in cases {
         bvh.sphere_spans(o, d, lo, hi, &mut stack, &mut out);
         assert!(out.is_empty(), "{o:?} {d:?} [{lo}, {hi}] listed {out:?}");
+        for isa in Isa::supported() {
+            let w = isa.dispatch(WideSpans {
+                bvh: &bvh,
+                wide: &wide,
+                o,
+                d,
+                lo,
+                hi,
+            });
+            assert!(
+                w.is_empty(),
+                "{isa} wide: {o:?} {d:?} [{lo}, {hi}] listed {w:?}"
+            );
+        }
     }
     // An axis-parallel ray through a centre finds that atom.
     bvh.sphere_spans(c, [0.0, 0.0, 2.0], 0.0, 0.0, &mut stack, &mut out);

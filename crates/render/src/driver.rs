@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 use scene::{Camera, Model};
 use spmd::Isa;
-use volume::VolumeScene;
+use volume::Medium;
 
 use crate::accum::{tone, Accum};
 use crate::camera_rays::ViewRays;
@@ -28,7 +28,7 @@ pub struct FrameInputs<'a> {
     /// The opaque pass (b&s); `None` for the volume alone.
     pub model: Option<&'a Model>,
     /// The volume pass; `None` for geometry alone.
-    pub volume: Option<&'a VolumeScene<'a>>,
+    pub volume: Option<&'a Medium<'a>>,
     /// The view.
     pub camera: &'a Camera,
 }

@@ -4,7 +4,7 @@
 //! wide BVH are built.
 
 use scene::{
-    BondSettings, LightVolumeSettings, ModelSettings, SceneSettings, VolumeSettings,
+    BondSettings, DensitySource, LightVolumeSettings, ModelSettings, SceneSettings, VolumeSettings,
     LIGHT_VOLUME_STRIDE,
 };
 use volume::{Light, Lighting, MarchOptions, VolumeShadows};
@@ -280,6 +280,9 @@ impl Look {
         if (self.shadows || self.ao.is_some()) && self.mode == Mode::Path {
             // The path tracer has its own lighting: these would be ignored.
             return Err(SettingsError::NeedsModel);
+        }
+        if self.volume_shadows && self.volume.source == DensitySource::Particles {
+            return Err(SettingsError::VolumeShadowsNeedGrid);
         }
         self.render_settings()
             .validate(self.mode.has_model(), self.mode.has_volume())

@@ -213,6 +213,12 @@ pub enum SettingsError {
          or --mode vol+bs --shadows"
     )]
     VolumeShadowsWithoutVolume,
+    /// Volume shadows through a grid-free volume.
+    #[error(
+        "--volume-shadows marches the density grid towards the light: use --volume grid \
+         (the default) or drop --volume-shadows with --volume particles"
+    )]
+    VolumeShadowsNeedGrid,
 }
 
 impl RenderSettings {

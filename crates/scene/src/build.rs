@@ -12,14 +12,15 @@ use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
     build_density, density_work, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells,
-    MarchOptions, TransferFunction, Volume, VolumeScene,
+    MarchOptions, Medium, ParticleScene, Particles, TransferFunction, Volume, VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
 use crate::memory::MemoryEstimate;
 use crate::model::{Coloring, Model, ModelOptions, Style};
 use crate::settings::{
-    BondSettings, BondSource, ColorBy, ModelSettings, RadiusKind, SceneSettings, VolumeSettings,
+    BondSettings, BondSource, ColorBy, DensitySource, ModelSettings, RadiusKind, SceneSettings,
+    VolumeSettings,
 };
 use crate::SceneError;
 
@@ -104,13 +105,51 @@ pub struct Timings {
     pub light_volume: f64,
 }
 
+/// Where the density volume's values come from.
+#[derive(Clone, Debug)]
+pub enum Density {
+    /// A grid of RBF density and its macrocells.
+    Grid {
+        /// The grid.
+        volume: Volume,
+        /// Its macrocells.
+        cells: Macrocells,
+    },
+    /// The atoms and the BVH over their support spheres (grid-free).
+    Particles(Particles),
+}
+
+impl Density {
+    /// The grid, when the density is sampled on one.
+    pub fn grid(&self) -> Option<&Volume> {
+        match self {
+            Density::Grid { volume, .. } => Some(volume),
+            Density::Particles(_) => None,
+        }
+    }
+
+    /// Largest density: over the lattice points, or over the atom centres.
+    pub fn max_value(&self) -> f32 {
+        match self {
+            Density::Grid { volume, .. } => volume.max_value,
+            Density::Particles(p) => p.max_value,
+        }
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> u64 {
+        match self {
+            Density::Grid { volume, cells } => volume.bytes() + cells.bytes(),
+            Density::Particles(p) => p.bytes(),
+        }
+    }
+}
+
 /// The density volume with what the marcher needs besides its options.
 #[derive(Clone, Debug)]
 pub struct DensityVolume {
-    /// The grid of RBF density.
-    pub volume: Volume,
-    /// Its macrocells.
-    pub cells: Macrocells,
+    /// The density: a grid, or the particles.
+    pub density: Density,
     /// The transfer function classified over `[0, tf_max]`.
     pub tf: ClassifiedTf,
     /// The density at the top of the transfer function: `VolumeSettings::density_max`, or
@@ -252,26 +291,8 @@ impl Scene {
             self.timings.model = t.elapsed().as_secs_f64();
         }
         if let Some(vs) = &st.volume {
-            let units = self
-                .estimate
-                .volume_dims
-                .map_or(0, |d| density_work(d, vs.format));
-            progress.start(Stage::Volume, units);
-            let t = Instant::now();
-            let volume = build_volume(
-                isa,
-                m,
-                vs,
-                st.budget_bytes,
-                &mut self.scratch.0,
-                &progress.done,
-            )?;
-            self.timings.volume = t.elapsed().as_secs_f64();
-            progress.start(Stage::Macrocells, 1);
-            let t = Instant::now();
-            let cells = Macrocells::build(&volume);
             let tf_max = match vs.density_max {
-                Some(d) if d > 0.0 && d.is_finite() => d,
+                Some(d) if d > 0.0 && d.is_finite() => Some(d),
                 Some(d) => {
                     return Err(SceneError::BadSetting {
                         name: "density-max",
@@ -279,24 +300,69 @@ impl Scene {
                         value: d,
                     })
                 }
-                None => volume.max_value,
+                None => None,
             };
+            let density = match vs.source {
+                DensitySource::Grid => {
+                    let units = self
+                        .estimate
+                        .volume_dims
+                        .map_or(0, |d| density_work(d, vs.format));
+                    progress.start(Stage::Volume, units);
+                    let t = Instant::now();
+                    let volume = build_volume(
+                        isa,
+                        m,
+                        vs,
+                        st.budget_bytes,
+                        &mut self.scratch.0,
+                        &progress.done,
+                    )?;
+                    self.timings.volume = t.elapsed().as_secs_f64();
+                    progress.start(Stage::Macrocells, 1);
+                    let t = Instant::now();
+                    let cells = Macrocells::build(&volume);
+                    self.timings.macrocells = t.elapsed().as_secs_f64();
+                    Density::Grid { volume, cells }
+                }
+                DensitySource::Particles => {
+                    if vs.light_volume.is_some() {
+                        return Err(SceneError::Unsupported(
+                            "volumetric shadows need the density grid: drop --volume-shadows \
+                             or use --volume grid",
+                        ));
+                    }
+                    progress.start(Stage::Volume, 1);
+                    let t = Instant::now();
+                    density_radii(m, &mut self.scratch.0);
+                    let p = Particles::build(
+                        &m.x,
+                        &m.y,
+                        &m.z,
+                        &self.scratch.0,
+                        vs.voxels_per_angstrom,
+                    )?;
+                    self.timings.volume = t.elapsed().as_secs_f64();
+                    Density::Particles(p)
+                }
+            };
+            let t = Instant::now();
+            let tf_max = tf_max.unwrap_or(density.max_value());
             let tf = ClassifiedTf::new(&vs.tf, 0.0, tf_max, vs.step_voxels);
-            self.timings.macrocells = t.elapsed().as_secs_f64();
+            self.timings.macrocells += t.elapsed().as_secs_f64();
             progress.done.store(1, Ordering::Relaxed);
             let d = DensityVolume {
-                volume,
-                cells,
+                density,
                 tf,
                 tf_max,
             };
-            if let Some(lv) = &vs.light_volume {
+            if let (Some(lv), Density::Grid { volume, cells }) = (&vs.light_volume, &d.density) {
                 progress.start(
                     Stage::LightVolume,
-                    LightVolume::planes(&d.volume.grid, lv.stride),
+                    LightVolume::planes(&volume.grid, lv.stride),
                 );
                 let t = Instant::now();
-                let scene = VolumeScene::new(&d.volume, &d.cells, &d.tf, MarchOptions::default());
+                let scene = VolumeScene::new(volume, cells, &d.tf, MarchOptions::default());
                 self.light_volume = Some(LightVolume::build_with_progress(
                     isa,
                     &scene,
@@ -335,13 +401,25 @@ impl Scene {
     }
 
     /// The marcher's view of the volume with options `opts`, with the light volume attached
-    /// when it was built for `opts.shadows`.
-    pub fn volume_scene(&self, opts: MarchOptions) -> Option<VolumeScene<'_>> {
+    /// when it was built for `opts.shadows`. Grid-free volumes have no shadows: `opts.shadows`
+    /// is dropped for them (the settings' validation refuses the combination first).
+    pub fn volume_scene(&self, opts: MarchOptions) -> Option<Medium<'_>> {
         let d = self.volume.as_ref()?;
-        let vs = VolumeScene::new(&d.volume, &d.cells, &d.tf, opts);
-        Some(match &self.light_volume {
-            Some(lv) if opts.shadows == Some(lv.shadows) => vs.with_light_volume(lv),
-            _ => vs,
+        Some(match &d.density {
+            Density::Grid { volume, cells } => {
+                let vs = VolumeScene::new(volume, cells, &d.tf, opts);
+                Medium::Grid(match &self.light_volume {
+                    Some(lv) if opts.shadows == Some(lv.shadows) => vs.with_light_volume(lv),
+                    _ => vs,
+                })
+            }
+            Density::Particles(p) => {
+                let opts = MarchOptions {
+                    shadows: None,
+                    ..opts
+                };
+                Medium::Particles(ParticleScene::new(p, &d.tf, opts))
+            }
         })
     }
 }

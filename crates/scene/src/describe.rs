@@ -131,6 +131,10 @@ impl<'a> Description<'a> {
         );
         let vpa = self.target.voxels_per_angstrom;
         memory.insert("voxels_per_angstrom".into(), json!(vpa));
+        memory.insert(
+            "volume_particles".into(),
+            json!(volume::Particles::estimate_bytes(m.len() as u64)),
+        );
         json!({
             "source": f.source,
             "format": f.format.map(|f| f.name()),
@@ -253,12 +257,14 @@ impl<'a> Description<'a> {
         }
         let d = est.volume_dims.unwrap_or([0; 3]);
         line(format!(
-            "volume:    {}x{}x{} lattice points at {vpa} /Å: {:.1} MB as u8, {:.1} MB as f32",
+            "volume:    {}x{}x{} lattice points at {vpa} /Å: {:.1} MB as u8, {:.1} MB as f32; \
+             grid-free (--volume particles) {:.1} MB",
             d[0],
             d[1],
             d[2],
             mb(est.volume),
-            mb(est.volume * 4)
+            mb(est.volume * 4),
+            mb(volume::Particles::estimate_bytes(m.len() as u64))
         ));
         out
     }

@@ -13,6 +13,9 @@ pub enum SceneError {
         /// The value given.
         value: f32,
     },
+    /// Two settings that do not go together (the message says which and the way out).
+    #[error("{0}")]
+    Unsupported(&'static str),
     /// Colouring by a per-atom column the input does not have.
     #[error("--color {name}: the input has no such per-atom column (it has: element{})",
         available.iter().map(|a| format!(", {a}")).collect::<String>())]

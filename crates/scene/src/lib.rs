@@ -23,7 +23,7 @@ mod report;
 mod settings;
 pub mod text;
 
-pub use build::{DensityVolume, Prepared, Progress, Scene, Stage, Timings, UnwrapReport};
+pub use build::{Density, DensityVolume, Prepared, Progress, Scene, Stage, Timings, UnwrapReport};
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
@@ -43,8 +43,8 @@ pub use memory::{
 pub use model::{Coloring, Model, ModelOptions, Style, CELL_COLOR};
 pub use periodic::{add_cell_edges, split_periodic_sticks};
 pub use settings::{
-    BondSettings, BondSource, ColorBy, LightVolumeSettings, ModelSettings, RadiusKind,
-    SceneSettings, VolumeSettings, LIGHT_VOLUME_STRIDE,
+    BondSettings, BondSource, ColorBy, DensitySource, LightVolumeSettings, ModelSettings,
+    RadiusKind, SceneSettings, VolumeSettings, LIGHT_VOLUME_STRIDE,
 };
 
 /// Packs an RGBA8 colour as the framebuffer stores it (`r | g << 8 | b << 16 | a << 24`).

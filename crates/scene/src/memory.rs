@@ -6,7 +6,8 @@
 use molecule::{elements, Molecule};
 use volume::{Grid, MACROCELL};
 
-use crate::build::{density_grid, model_prim_count, Scene};
+use crate::build::{density_grid, model_prim_count, Density, Scene};
+use crate::settings::DensitySource;
 use crate::settings::SceneSettings;
 use crate::SceneError;
 
@@ -105,7 +106,16 @@ impl MemoryEstimate {
                 e.wide_bvh = (prims as f64 * WIDE_NODES_PER_PRIM).ceil() as u64 * WIDE_NODE_BYTES;
             }
         }
-        if let Some(vs) = &settings.volume {
+        if settings
+            .volume
+            .as_ref()
+            .is_some_and(|vs| vs.source == DensitySource::Particles)
+        {
+            // The BVH over the support spheres; while it is built, the geometry copy
+            // (20 B/atom), the support radii and the builder's 32-byte references.
+            e.volume = volume::Particles::estimate_bytes(m.len() as u64);
+            counts.density_scratch = m.len() as u64 * (20 + 4 + 32);
+        } else if let Some(vs) = &settings.volume {
             let grid = density_grid(m, vs)?;
             counts.slab_entries = slab_entries(m, &grid);
             counts.density_scratch = volume::estimate_bytes(&grid, vs.format)
@@ -147,10 +157,14 @@ impl MemoryEstimate {
                 e.wide_bvh = md.wide().bytes() as u64;
             }
         }
-        if let Some(d) = &scene.volume {
-            e.volume = d.volume.bytes();
-            e.volume_dims = Some(d.volume.grid.dims);
-            e.macrocells = d.cells.bytes();
+        match scene.volume.as_ref().map(|d| &d.density) {
+            Some(Density::Grid { volume, cells }) => {
+                e.volume = volume.bytes();
+                e.volume_dims = Some(volume.grid.dims);
+                e.macrocells = cells.bytes();
+            }
+            Some(Density::Particles(p)) => e.volume = p.bytes(),
+            None => {}
         }
         if let Some(lv) = &scene.light_volume {
             e.light_volume = lv.bytes();

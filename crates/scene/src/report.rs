@@ -1,6 +1,7 @@
 //! What a build made and what it took, one line per stage, for `-v` and progress logs.
 
 use crate::build::Scene;
+use crate::Density;
 
 impl Scene {
     /// One line per built stage (`unwrap:`, `bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
@@ -35,14 +36,27 @@ impl Scene {
             ));
         }
         if let (Some(d), Some(vs)) = (&self.volume, &self.settings.volume) {
-            out.push(format!(
-                "volume:  {:.3} s  {:?} lattice points at {} /Å, {:.1} MB {}",
-                t.volume + t.macrocells,
-                d.volume.grid.dims,
-                vs.voxels_per_angstrom,
-                d.volume.bytes() as f64 / 1e6,
-                d.volume.format().name()
-            ));
+            out.push(match &d.density {
+                Density::Grid { volume, .. } => format!(
+                    "volume:  {:.3} s  {:?} lattice points at {} /Å, {:.1} MB {}",
+                    t.volume + t.macrocells,
+                    volume.grid.dims,
+                    vs.voxels_per_angstrom,
+                    volume.bytes() as f64 / 1e6,
+                    volume.format().name()
+                ),
+                Density::Particles(p) => format!(
+                    "volume:  {:.3} s  grid-free, {} atoms in a BVH of {} nodes, step {:.3} Å, \
+                     {:.1} MB ({:.1} B/atom), max density {:.3}",
+                    t.volume + t.macrocells,
+                    p.radius.len(),
+                    p.bvh.stats.nodes,
+                    vs.step_voxels / vs.voxels_per_angstrom,
+                    p.bytes() as f64 / 1e6,
+                    p.bytes() as f64 / p.radius.len().max(1) as f64,
+                    p.max_value
+                ),
+            });
         }
         if let Some(lv) = &self.light_volume {
             out.push(format!(

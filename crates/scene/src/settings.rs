@@ -130,10 +130,27 @@ impl LightVolumeSettings {
     }
 }
 
+/// Where the volume's RBF density is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum DensitySource {
+    /// Sampled once on a grid of `voxels_per_angstrom`, then interpolated (paper §3.1):
+    /// fastest to march, memory grows with the voxels.
+    #[default]
+    Grid,
+    /// Summed from the atoms at every sample through a BVH over their support spheres
+    /// (grid-free): exact, memory grows with the atoms; `voxels_per_angstrom` sets only the
+    /// step. No volumetric shadows.
+    Particles,
+}
+
 /// The RBF density volume (paper §3.1) and what is derived from it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VolumeSettings {
-    /// Grid resolution (voxels per Å, > 0; the paper uses 4, and 1 for sio2 and anp3).
+    /// Where the density is evaluated: a grid, or the atoms themselves.
+    pub source: DensitySource,
+    /// Grid resolution (voxels per Å, > 0; the paper uses 4, and 1 for sio2 and anp3); the
+    /// step is half a voxel, whatever the source.
     pub voxels_per_angstrom: f32,
     /// Voxel storage.
     pub format: VolumeFormat,
@@ -151,6 +168,7 @@ pub struct VolumeSettings {
 impl Default for VolumeSettings {
     fn default() -> Self {
         VolumeSettings {
+            source: DensitySource::Grid,
             voxels_per_angstrom: 4.0,
             format: VolumeFormat::U8,
             tf: TransferFunction::preset(volume::Preset::CoolWarm),

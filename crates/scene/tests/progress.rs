@@ -89,9 +89,10 @@ fn every_stage_counts_up_to_its_announced_units() {
         let plain = Scene::build(Isa::Scalar, &m, &st).unwrap();
         assert_eq!(plain.bonds, scene.bonds);
         assert_eq!(plain.model.unwrap().bvh.nodes, md.bvh.nodes);
+        let plain_volume = plain.volume.unwrap();
         let (a, b) = (
-            &plain.volume.unwrap().volume,
-            &scene.volume.as_ref().unwrap().volume,
+            plain_volume.density.grid().unwrap(),
+            scene.volume.as_ref().unwrap().density.grid().unwrap(),
         );
         assert_eq!(a.data, b.data);
     }

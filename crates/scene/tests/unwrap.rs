@@ -120,7 +120,8 @@ fn unwrapping_also_moves_the_volume() {
     let s = Scene::build(Isa::Scalar, &split_water(), &settings(true, false, false)).unwrap();
     assert!(s.model.is_none() && s.bonds.is_empty());
     assert_eq!(s.sphere, want.sphere);
-    let (a, b) = (&s.volume.unwrap().volume, &want.volume.unwrap().volume);
+    let (a, b) = (s.volume.unwrap().density, want.volume.unwrap().density);
+    let (a, b) = (a.grid().unwrap(), b.grid().unwrap());
     assert_eq!(a.grid.dims, b.grid.dims);
     assert_eq!(a.grid.origin, b.grid.origin);
 }

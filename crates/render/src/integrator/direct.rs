@@ -67,7 +67,7 @@ pub(super) fn visibility<S: Simd>(
     let occ = q.occluded(s, &sray, st);
     let free = m & !occ;
     let mut vis = s.select(free, one, zero);
-    if let (true, Some(vs)) = (k.set.volume_shadows, k.volume) {
+    if let (true, Some(vs)) = (k.set.volume_shadows, k.volume.and_then(|m| m.grid())) {
         if s.any(free) {
             let tr = volume::transmittance(s, vs, o, l, dist, free, k.set.shadow_step_voxels);
             vis = s.select(free, tr, vis);

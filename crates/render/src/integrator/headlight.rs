@@ -104,7 +104,7 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &TileJob<'_>, out: &mut [u32]) 
                 // Pass 2 (§4.2, §4.4): the volume in front of the opaque hit, composited over it.
                 let color = match k.volume {
                     Some(vs) => {
-                        let c = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
+                        let c = vs.march(s, ray.o, ray.d, depth, ray.active);
                         s.select_i(ray.active, over(s, c, color), color)
                     }
                     None => color,

@@ -18,7 +18,7 @@ pub(crate) use ao::ao_factor;
 use bvh::{surface, PacketHit, Query, RayPacket, Stacks};
 use scene::Model;
 use spmd::{Kernel, Simd, V3};
-use volume::VolumeScene;
+use volume::Medium;
 
 use crate::camera_rays::ViewRays;
 use crate::settings::{Modality, RenderSettings};
@@ -36,7 +36,7 @@ pub(crate) enum TileOut {
 /// One tile of one frame: the kernel the driver dispatches per tile.
 pub(crate) struct TileJob<'a> {
     pub(crate) model: Option<&'a Model>,
-    pub(crate) volume: Option<&'a VolumeScene<'a>>,
+    pub(crate) volume: Option<&'a Medium<'a>>,
     pub(crate) view: &'a ViewRays,
     pub(crate) set: &'a RenderSettings,
     /// Top-left pixel of the tile.
@@ -124,7 +124,7 @@ pub struct Traced<S: Simd> {
 pub fn trace<S: Simd>(
     s: S,
     model: Option<&Model>,
-    volume: Option<&VolumeScene>,
+    volume: Option<&Medium>,
     ray: &RayPacket<S>,
     stack: &mut [u32],
 ) -> Traced<S> {
@@ -134,7 +134,7 @@ pub fn trace<S: Simd>(
     };
     if let Some(vs) = volume {
         let depth = s.select(out.mask, out.hit.t, s.splat(f32::INFINITY));
-        out.volume = volume::march(s, vs, ray.o, ray.d, depth, ray.active);
+        out.volume = vs.march(s, ray.o, ray.d, depth, ray.active);
     }
     out
 }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 mod rays;
+#[allow(unused_imports)]
 pub use rays::*;
 
 /// SplitMix64: deterministic, independent of any crate.

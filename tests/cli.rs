@@ -321,6 +321,13 @@ fn grid_free_volume_renders_the_grid_picture_and_refuses_shadows() {
     let ((ok, _, err), shadowed) = render("particles", "s.png", &["--volume-shadows"]);
     assert!(!ok && err.contains("--volume grid"), "{err}");
     assert!(!shadowed.exists());
+    // No grid to outgrow the memory: a hostile resolution is refused, not marched for hours.
+    let ((ok, _, err), fine) = render("particles", "f.png", &["--voxels-per-angstrom", "1000"]);
+    assert!(
+        !ok && err.contains("at most 32 with --volume particles"),
+        "{err}"
+    );
+    assert!(!fine.exists());
 }
 
 #[test]

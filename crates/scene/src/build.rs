@@ -105,6 +105,9 @@ pub struct Timings {
     pub light_volume: f64,
 }
 
+/// Finest resolution (voxels per Å, i.e. steps of half of 1/this Å) of a grid-free volume.
+pub const MAX_PARTICLE_RESOLUTION: f32 = 32.0;
+
 /// Where the density volume's values come from.
 #[derive(Clone, Debug)]
 pub enum Density {
@@ -331,6 +334,17 @@ impl Scene {
                             "volumetric shadows need the density grid: drop --volume-shadows \
                              or use --volume grid",
                         ));
+                    }
+                    // The grid's size caps its resolution; here only time would grow (250×
+                    // the samples of 4 /Å at 1000 /Å): cap it where steps are far finer than
+                    // any atom (covalent radii ≥ 0.31 Å).
+                    if vs.voxels_per_angstrom > MAX_PARTICLE_RESOLUTION {
+                        return Err(SceneError::BadSetting {
+                            name: "voxels-per-angstrom",
+                            expected: "at most 32 with --volume particles (steps of 1/64 Å; \
+                                       finer steps cost time and change nothing visible)",
+                            value: vs.voxels_per_angstrom,
+                        });
                     }
                     progress.start(Stage::Volume, 1);
                     let t = Instant::now();

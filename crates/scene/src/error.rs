@@ -75,7 +75,8 @@ pub enum SceneError {
         /// The frame asked for.
         frame: i64,
     },
-    /// The density volume failed (bad input, resolution or over its own budget).
-    #[error("building the density volume: {0}")]
+    /// The density volume failed (bad input, resolution or over its own budget); its
+    /// message names the volume (shown once, also in an error chain).
+    #[error(transparent)]
     Volume(#[from] volume::VolumeError),
 }

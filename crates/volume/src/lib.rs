@@ -52,6 +52,28 @@
 //! ```
 //! Inside a renderer's own SIMD kernel, call [`march()`] on a packet instead
 //! (`march::<S>(s, &scene, orig, dir, tmax, active)` → `[r, g, b, a]` varying).
+//!
+//! ## Grid-free
+//! [`Particles::build`] puts the atoms' support spheres in a BVH instead of sampling a grid;
+//! [`ParticleScene`] and [`march_particles`] / [`march_particle_rays`] march it with the same
+//! transfer function, options and output (no volumetric shadows). [`Medium`] is either, for
+//! a renderer that takes both.
+//! ```
+//! use spmd::Isa;
+//! use volume::*;
+//! # fn main() -> Result<(), VolumeError> {
+//! let (x, y, z, r) = (vec![0.0f32, 1.4], vec![0.0f32, 0.0], vec![0.0f32, 0.0], vec![0.76f32; 2]);
+//! let p = Particles::build(&x, &y, &z, &r, 4.0)?; // 4 /Å: steps of 0.125 Å
+//! let tf = ClassifiedTf::new(&TransferFunction::preset(Preset::CoolWarm), 0.0, p.max_value, 0.5);
+//! let scene = ParticleScene::new(&p, &tf, MarchOptions::default());
+//! let (ox, oy, oz, dx, dy, dz) = ([-5.0f32], [0.0f32], [0.0f32], [1.0f32], [0.0f32], [0.0f32]);
+//! let tmax = [f32::INFINITY];
+//! let mut rgba = [[0.0f32; 4]];
+//! let rays = Rays { origin: [&ox, &oy, &oz], dir: [&dx, &dy, &dz], tmax: &tmax };
+//! march_particle_rays(Isa::detect(), &scene, &rays, &mut rgba);
+//! assert!(rgba[0][3] > 0.0);
+//! # Ok(()) }
+//! ```
 
 #![warn(missing_docs)]
 

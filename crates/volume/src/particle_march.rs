@@ -194,7 +194,7 @@ pub fn march_particles<S: Simd>(
         // Out of the thread-local and back, so the marching itself runs outside a closure
         // (closures do not inherit the backend's target features: its intrinsics would
         // become calls).
-        let mut sc = SCRATCH.with(RefCell::take);
+        let mut sc = SCRATCH.take();
         while bits != 0 {
             let l = bits.trailing_zeros() as usize;
             bits &= bits - 1;
@@ -214,7 +214,7 @@ pub fn march_particles<S: Simd>(
                 out[ch][l] = c[ch];
             }
         }
-        SCRATCH.with(|cell| cell.replace(sc));
+        SCRATCH.set(sc);
     }
     [
         s.load(&out[0]),

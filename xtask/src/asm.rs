@@ -89,11 +89,11 @@ const NO_OUT_OF_LINE_VOLUME: &[&str] = &[
     "call*<volume::",
 ];
 
-/// As [`NO_OUT_OF_LINE_VOLUME`] for the render tiles, which also hold the grid-free marcher:
-/// its per-ray bookkeeping may stay out of line (the thread-local scratch taken and set back,
+/// As [`NO_OUT_OF_LINE_VOLUME`] for the entry points that also hold the grid-free marcher
+/// (render tiles, the march batch): its per-ray bookkeeping may stay out of line (the thread-local scratch taken and set back,
 /// the sort of a window's spheres, the scratch's drop on unwinding), never its per-sample
 /// code nor the grid marcher's.
-const NO_OUT_OF_LINE_RENDER: &[&str] = &[
+const NO_OUT_OF_LINE_MARCH: &[&str] = &[
     "call*core_arch",
     "call*<spmd::x86",
     "call*as spmd::Simd",
@@ -142,14 +142,14 @@ pub const RULES: &[Rule] = &[
         binary: Binary::VolumeBench,
         symbol: "spmd::x86::{isa}::entry::<volume::march::MarchBatch",
         must: &["{reg}"],
-        must_not: NO_OUT_OF_LINE_VOLUME,
+        must_not: NO_OUT_OF_LINE_MARCH,
     },
     Rule {
         what: "render tiles (headlight, sampled)",
         binary: Binary::Bnsview,
         symbol: "spmd::x86::{isa}::entry::<render::integrator::",
         must: &["{reg}"],
-        must_not: NO_OUT_OF_LINE_RENDER,
+        must_not: NO_OUT_OF_LINE_MARCH,
     },
 ];
 

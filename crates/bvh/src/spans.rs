@@ -2,6 +2,7 @@
 //! grid-free RBF volumes, which sum the Gaussians of the atoms whose support spheres a ray
 //! crosses (Knoll et al., "RBF volume ray casting on multicore and many-core CPUs", 2014).
 
+use crate::geometry::PrimRecord;
 use crate::tree::Bvh;
 
 /// The part `[t0, t1]` of a ray inside the sphere in leaf slot `slot` (`t` in units of the
@@ -20,15 +21,68 @@ pub struct Span {
 /// `d² < r²` test would keep (the caller decides at each point; the span only culls).
 const WIDEN: f32 = 1e-4;
 
+/// One span query: the ray `o + t·d` and the range `[t_lo, t_hi]`, checked once, with what
+/// both traversals ([`Bvh::sphere_spans`], [`crate::WideBvh::sphere_spans`]) share.
+#[derive(Clone, Copy)]
+pub(crate) struct SpanQuery {
+    pub(crate) o: [f32; 3],
+    pub(crate) d: [f32; 3],
+    /// `d·d`.
+    dd: f32,
+    pub(crate) t_lo: f32,
+    pub(crate) t_hi: f32,
+}
+
+impl SpanQuery {
+    /// The query, or `None` when it can list nothing: a zero, NaN or infinite `o` or `d`, or
+    /// an empty (or NaN) range.
+    pub(crate) fn new(o: [f32; 3], d: [f32; 3], t_lo: f32, t_hi: f32) -> Option<SpanQuery> {
+        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let finite = o.iter().chain(d.iter()).all(|v| v.is_finite());
+        (finite && dd > 0.0 && dd.is_finite() && t_lo <= t_hi).then_some(SpanQuery {
+            o,
+            d,
+            dd,
+            t_lo,
+            t_hi,
+        })
+    }
+
+    /// Appends the spans of the sphere records in `slots` (sticks skipped) that overlap the
+    /// range: a leaf's part of the query.
+    #[inline(always)]
+    pub(crate) fn leaf(
+        &self,
+        records: &[PrimRecord],
+        slots: std::ops::Range<usize>,
+        out: &mut Vec<Span>,
+    ) {
+        for slot in slots {
+            let rec = &records[slot];
+            if !rec.is_sphere() {
+                continue;
+            }
+            if let Some((t0, t1)) = chord(self.o, self.d, self.dd, rec.p0, rec.r) {
+                if t0 <= self.t_hi && t1 >= self.t_lo {
+                    out.push(Span {
+                        t0,
+                        t1,
+                        slot: slot as u32,
+                    });
+                }
+            }
+        }
+    }
+}
+
 impl Bvh {
     /// Appends to `out` every sphere (ball primitive; sticks are skipped) that the ray
     /// `o + t·d` passes through for some `t` in `[t_lo, t_hi]`, with its whole chord (not
     /// clipped to the range, so a caller walking the ray in windows can tell the spheres it
     /// has already met: those entered before the window) widened by 10⁻⁴ of the sphere's
-    /// radius each way. `d` need not be unit; `t`
-    /// is in units of it. Spans come in traversal order, not sorted. A zero, NaN or infinite
-    /// `d` or `o`, or an empty range, gives none. `stack` must hold [`Bvh::stack_size`]
-    /// entries.
+    /// radius each way. `d` need not be unit; `t` is in units of it. Spans come in traversal
+    /// order, not sorted. A zero, NaN or infinite `d` or `o`, or an empty range, gives none.
+    /// `stack` must hold [`Bvh::stack_size`] entries.
     ///
     /// With `t_lo = t_hi = 0` this lists the spheres that contain the point `o`.
     pub fn sphere_spans(
@@ -40,11 +94,9 @@ impl Bvh {
         stack: &mut [u32],
         out: &mut Vec<Span>,
     ) {
-        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        let finite = o.iter().chain(d.iter()).all(|v| v.is_finite());
-        if !(finite && dd > 0.0 && dd.is_finite() && t_lo <= t_hi) || self.nodes.is_empty() {
+        let Some(q) = SpanQuery::new(o, d, t_lo, t_hi).filter(|_| !self.nodes.is_empty()) else {
             return;
-        }
+        };
         let inv = d.map(|v| 1.0 / v);
         let mut sp = 0usize;
         let mut idx = 0usize;
@@ -53,21 +105,7 @@ impl Bvh {
             if slab_overlap(&node.min, &node.max, o, inv, t_lo, t_hi) {
                 if node.is_leaf() {
                     let first = node.first as usize;
-                    for slot in first..first + node.count() {
-                        let rec = &self.records[slot];
-                        if !rec.is_sphere() {
-                            continue;
-                        }
-                        if let Some((t0, t1)) = chord(o, d, dd, rec.p0, rec.r) {
-                            if t0 <= t_hi && t1 >= t_lo {
-                                out.push(Span {
-                                    t0,
-                                    t1,
-                                    slot: slot as u32,
-                                });
-                            }
-                        }
-                    }
+                    q.leaf(&self.records, first..first + node.count(), out);
                 } else {
                     stack[sp] = node.first + 1;
                     sp += 1;
@@ -109,7 +147,7 @@ fn slab_overlap(
 /// widened by `WIDEN·r`; `None` if the ray passes outside. Closest approach first, so the
 /// perpendicular distance carries no cancellation from a far origin.
 #[inline(always)]
-pub(crate) fn chord(o: [f32; 3], d: [f32; 3], dd: f32, c: [f32; 3], r: f32) -> Option<(f32, f32)> {
+fn chord(o: [f32; 3], d: [f32; 3], dd: f32, c: [f32; 3], r: f32) -> Option<(f32, f32)> {
     let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
     let tc = -(oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2]) / dd;
     let p = [oc[0] + tc * d[0], oc[1] + tc * d[1], oc[2] + tc * d[2]];

@@ -49,6 +49,13 @@ pub struct WideNode {
 }
 
 impl WideNode {
+    /// Lower and upper corners of children `c .. c + S::LANES` (zeros past the last), for
+    /// one SIMD box test.
+    #[inline(always)]
+    pub fn boxes<S: Simd>(&self, s: S, c: usize) -> (V3<S>, V3<S>) {
+        (corners(s, &self.min, c), corners(s, &self.max, c))
+    }
+
     const EMPTY: WideNode = WideNode {
         n: 0,
         count: [0; WIDTH],
@@ -57,6 +64,17 @@ impl WideNode {
         max: [[0.0; WIDTH]; 3],
         child: [0; WIDTH],
     };
+}
+
+/// Corners `c ..` of one side of a node's boxes (a function, not a closure: closures may not
+/// inherit the backend's target features).
+#[inline(always)]
+fn corners<S: Simd>(s: S, b: &[[f32; WIDTH]; 3], c: usize) -> V3<S> {
+    V3::new(
+        s.load_partial(&b[0][c..], 0.0),
+        s.load_partial(&b[1][c..], 0.0),
+        s.load_partial(&b[2][c..], 0.0),
+    )
 }
 
 /// A stack entry of the wide traversal: a child reference and the distance where the ray
@@ -293,16 +311,7 @@ impl WideBvh {
             let mut nf = 0usize;
             let mut c = 0usize;
             while c < n {
-                let lo = V3::new(
-                    s.load_partial(&node.min[0][c..], 0.0),
-                    s.load_partial(&node.min[1][c..], 0.0),
-                    s.load_partial(&node.min[2][c..], 0.0),
-                );
-                let hi = V3::new(
-                    s.load_partial(&node.max[0][c..], 0.0),
-                    s.load_partial(&node.max[1][c..], 0.0),
-                    s.load_partial(&node.max[2][c..], 0.0),
-                );
+                let (lo, hi) = node.boxes(s, c);
                 let (m, entry) = slab_test(s, lo, hi, o, inv, tmin, tv, grow);
                 let m = m & s.first_n(n - c);
                 let mut bits = s.bitmask(m);

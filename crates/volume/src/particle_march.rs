@@ -13,11 +13,12 @@
 use std::cell::RefCell;
 
 use bvh::{Bvh, Span, WideBvh};
-use spmd::{Isa, Kernel, Simd, V3};
+use spmd::{Isa, Simd, V3};
 
-use crate::march::{half_hi, half_lo, load3, Rays};
+use crate::march::{classify, march_medium_rays, Rays};
+use crate::medium::Medium;
 use crate::particles::Particles;
-use crate::sampler::{bin, clip_box, GridRay};
+use crate::sampler::{clip_box, facing, GridRay};
 use crate::scene::{Light, Lighting, MarchOptions};
 use crate::tf::ClassifiedTf;
 
@@ -319,11 +320,8 @@ fn march_ray<S: Simd>(
                     Some(light) => light.towards(s, ov.mul_add(dv, t)).0,
                     None => headlight,
                 };
-                let len2 = grad.dot(grad);
-                let ok = s.gt(len2, s.splat(1e-20));
+                let f = facing(s, grad, l);
                 let one = s.splat(1.0);
-                let ndotl = s.abs(grad.dot(l)) * s.rsqrt(s.select(ok, len2, one));
-                let f = s.select(ok, s.min(ndotl, one), one);
                 let ambient = s.splat(opts.ambient);
                 let shade = ambient + (one - ambient) * f;
                 for ch in c.iter_mut().take(3) {
@@ -384,82 +382,8 @@ fn density_at<S: Simd>(s: S, act: &Active, d: V3<S>, t: S::F32, lit: bool) -> (S
     (val, grad)
 }
 
-// Paper §4.4: segment colour and opacity from the pre-integration table (front, back values)
-// or the post-classification table (back value), as the grid marcher reads them.
-#[inline(always)]
-fn classify<S: Simd>(
-    s: S,
-    tf: &ClassifiedTf,
-    front: S::F32,
-    back: S::F32,
-    m: S::M,
-    preint: bool,
-) -> [S::F32; 4] {
-    if preint {
-        let idx = s.shl(s.shl(bin(s, tf, front), 8) + bin(s, tf, back), 1);
-        let rg = s.gather_i(&tf.preint_half, idx, m, s.splat_i(0));
-        let ba = s.gather_i(&tf.preint_half, idx + s.splat_i(1), m, s.splat_i(0));
-        [
-            half_lo(s, rg),
-            half_hi(s, rg),
-            half_lo(s, ba),
-            half_hi(s, ba),
-        ]
-    } else {
-        let idx = s.shl(bin(s, tf, back), 2);
-        let zero = s.splat(0.0);
-        [
-            s.gather(&tf.post, idx, m, zero),
-            s.gather(&tf.post, idx + s.splat_i(1), m, zero),
-            s.gather(&tf.post, idx + s.splat_i(2), m, zero),
-            s.gather(&tf.post, idx + s.splat_i(3), m, zero),
-        ]
-    }
-}
-
-struct ParticleBatch<'a, 'b> {
-    scene: &'a ParticleScene<'a>,
-    rays: &'a Rays<'a>,
-    out: &'b mut [[f32; 4]],
-}
-
-impl Kernel for ParticleBatch<'_, '_> {
-    type Output = ();
-    // A batch of rays, LANES at a time, through `march_particles`.
-    #[inline(always)]
-    fn run<S: Simd>(self, s: S) {
-        let n = self.rays.len();
-        let r = self.rays;
-        let mut buf = [0.0f32; spmd::MAX_LANES];
-        let mut i = 0;
-        while i < n {
-            let orig = load3(s, r.origin, i);
-            let dir = load3(s, r.dir, i);
-            let tmax = s.load_partial(&r.tmax[i..], 0.0);
-            let c = march_particles(s, self.scene, orig, dir, tmax, s.first_n(n - i));
-            let cnt = (n - i).min(S::LANES);
-            for (ch, v) in c.into_iter().enumerate() {
-                s.store(v, &mut buf);
-                for (o, b) in self.out[i..i + cnt].iter_mut().zip(buf) {
-                    o[ch] = b;
-                }
-            }
-            i += S::LANES;
-        }
-    }
-}
-
 /// Marches every ray of `rays` through `scene` with backend `isa`, as [`crate::march_rays`]
 /// does through a grid. Panics if the slices' lengths differ.
 pub fn march_particle_rays(isa: Isa, scene: &ParticleScene, rays: &Rays, out: &mut [[f32; 4]]) {
-    let n = rays.len();
-    assert!(
-        rays.origin
-            .iter()
-            .chain(rays.dir.iter())
-            .all(|a| a.len() == n)
-            && out.len() == n,
-        "march_particle_rays: ray and output slices must have equal lengths"
-    );
-    isa.dispatch(ParticleBatch { scene, rays, out });
+    march_medium_rays(isa, &Medium::Particles(*scene), rays, out);
 }

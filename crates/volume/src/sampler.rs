@@ -245,17 +245,23 @@ pub(crate) fn diffuse<S: Simd, V: Voxels>(
     l: V3<S>,
     m: S::M,
 ) -> S::F32 {
-    let one = s.splat(1.0);
     let gx = trilinear(s, lat, offset(s, p, 1.0, 0.0, 0.0), m)
         - trilinear(s, lat, offset(s, p, -1.0, 0.0, 0.0), m);
     let gy = trilinear(s, lat, offset(s, p, 0.0, 1.0, 0.0), m)
         - trilinear(s, lat, offset(s, p, 0.0, -1.0, 0.0), m);
     let gz = trilinear(s, lat, offset(s, p, 0.0, 0.0, 1.0), m)
         - trilinear(s, lat, offset(s, p, 0.0, 0.0, -1.0), m);
-    let gv = V3::<S>::new(gx, gy, gz);
-    let len2 = gv.dot(gv);
+    facing(s, V3::<S>::new(gx, gy, gz), l)
+}
+
+/// `|n·l|` with `n` the normalised gradient `g` (at most 1; 1 where `g` vanishes): the
+/// diffuse factor of gradient shading, whatever the gradient comes from.
+#[inline(always)]
+pub(crate) fn facing<S: Simd>(s: S, g: V3<S>, l: V3<S>) -> S::F32 {
+    let one = s.splat(1.0);
+    let len2 = g.dot(g);
     let ok = s.gt(len2, s.splat(1e-20));
-    let ndotl = s.abs(gv.dot(l)) * s.rsqrt(s.select(ok, len2, one));
+    let ndotl = s.abs(g.dot(l)) * s.rsqrt(s.select(ok, len2, one));
     s.select(ok, s.min(ndotl, one), one)
 }
 

@@ -23,13 +23,8 @@ fn single_atom_matches_double_precision_reference_integration() {
     let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);
     let field = |q: [f64; 3]| phi(&atoms, q);
     let b = atom_rays(f32::INFINITY);
-    let want: Vec<[f64; 4]> = (0..b.tmax.len())
-        .map(|i| {
-            let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-            let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-            reference(&field, &tf, 0.0, hi as f64, &v.grid, o, d, b.tmax[i] as f64)
-        })
-        .collect();
+    let reference = Reference::new(&field, &tf, hi, &v.grid);
+    let want = reference.batch(&b, 0.002, &unshaded);
     assert!(
         want.iter().filter(|w| w[3] > 0.2).count() > 10,
         "rays must cross dense parts"
@@ -38,26 +33,10 @@ fn single_atom_matches_double_precision_reference_integration() {
         want.iter().filter(|w| w[3] == 0.0).count() > 3,
         "and some must miss"
     );
-    for (preintegrated, tol) in [(true, 3.0 / 255.0), (false, 9.0 / 255.0)] {
-        for macrocells in [true, false] {
-            let opts = MarchOptions {
-                preintegrated,
-                macrocells,
-                ..Default::default()
-            };
-            let sc = VolumeScene::new(&v, &mc, &ctf, opts);
-            for isa in Isa::supported() {
-                let got = b.render(isa, &sc);
-                let e = max_err(&got, &want);
-                eprintln!(
-                    "preint {preintegrated} cells {macrocells} {isa}: max error {e:.5} ({:.2}/255)",
-                    e * 255.0
-                );
-                assert!(
-                    e <= tol,
-                    "preint {preintegrated} cells {macrocells} {isa}: max error {e}"
-                );
-            }
+    for (opts, tol, label) in classification_opts(3.0 / 255.0, 9.0 / 255.0) {
+        let sc = VolumeScene::new(&v, &mc, &ctf, opts);
+        for isa in Isa::supported() {
+            assert_near(&format!("{label} {isa}"), &b.render(isa, &sc), &want, tol);
         }
     }
 }
@@ -95,7 +74,7 @@ fn macrocell_skipping_matches_no_skipping_within_one_255th() {
     for format in [VolumeFormat::U8, VolumeFormat::F32] {
         let (v, mc) = shell_scene(format);
         for preset in Preset::ALL {
-            let ctf = ClassifiedTf::new(&TransferFunction::preset(preset), 0.0, v.max_value, 0.5);
+            let ctf = preset_tf(preset, v.max_value);
             // The test means something only if most cells are empty under this TF.
             let empty = (0..mc.minmax.len() / 2)
                 .filter(|&c| {
@@ -134,12 +113,7 @@ fn macrocell_skipping_matches_no_skipping_within_one_255th() {
 #[test]
 fn every_backend_agrees_with_scalar() {
     let (v, mc) = shell_scene(VolumeFormat::U8);
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::Viridis),
-        0.0,
-        v.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::Viridis, v.max_value);
     let b = scattered_rays(203, 9); // not a multiple of any lane count
     for opts in all_opts().into_iter().flat_map(|o| {
         [
@@ -153,15 +127,8 @@ fn every_backend_agrees_with_scalar() {
         let sc = VolumeScene::new(&v, &mc, &ctf, opts);
         let want = b.render(Isa::Scalar, &sc);
         for isa in Isa::supported() {
-            let got = b.render(isa, &sc);
-            for (i, (x, y)) in got.iter().zip(&want).enumerate() {
-                for c in 0..4 {
-                    assert!(
-                        (x[c] - y[c]).abs() <= 1e-5,
-                        "{isa} {opts:?} ray {i}: {x:?} vs scalar {y:?}"
-                    );
-                }
-            }
+            let what = |_| format!("{isa} {opts:?} against scalar");
+            assert_agree(&b.render(isa, &sc), &want, 1e-5, &what);
         }
     }
 }
@@ -169,12 +136,7 @@ fn every_backend_agrees_with_scalar() {
 #[test]
 fn opaque_depth_and_empty_transfer_function() {
     let (v, mc) = shell_scene(VolumeFormat::F32);
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::CoolWarm),
-        0.0,
-        v.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::CoolWarm, v.max_value);
     let sc = VolumeScene::new(&v, &mc, &ctf, MarchOptions::default());
     let mut b = Batch::new();
     // Straight through the centre along +x: crosses both shells twice.
@@ -238,12 +200,7 @@ fn batch_sampler_and_classifier_match_scalar_references() {
         pts.iter().map(|p| p[1] as f32).collect(),
         pts.iter().map(|p| p[2] as f32).collect(),
     );
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::Viridis),
-        0.0,
-        v.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::Viridis, v.max_value);
     for isa in Isa::supported() {
         let mut out = vec![0.0; n];
         sample_points(isa, &v, &x, &y, &z, &mut out);
@@ -331,12 +288,7 @@ fn lighting_scales_colour_only() {
 #[test]
 fn degenerate_rays_terminate_with_nothing() {
     let (v, mc) = shell_scene(VolumeFormat::U8);
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::CoolWarm),
-        0.0,
-        v.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::CoolWarm, v.max_value);
     let mut b = Batch::new();
     b.push([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], f32::INFINITY); // zero direction
     b.push([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY);
@@ -364,54 +316,6 @@ fn degenerate_rays_terminate_with_nothing() {
     }
 }
 
-/// Transmittance from `p` towards the light to the box's exit (or the point light) in f64:
-/// midpoint rule with steps of `dv` voxels over the analytic field.
-#[allow(clippy::too_many_arguments)]
-fn reference_transmittance(
-    field: &dyn Fn([f64; 3]) -> f64,
-    tf: &TransferFunction,
-    lo: f64,
-    hi: f64,
-    grid: &Grid,
-    p: [f64; 3],
-    light: Light,
-    dv: f64,
-) -> f64 {
-    let (dir, dist) = match light {
-        Light::Directional(l) => {
-            let l = l.map(|x| x as f64);
-            let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-            (l.map(|x| x / n), f64::INFINITY)
-        }
-        Light::Point(q) => {
-            let d: [f64; 3] = core::array::from_fn(|a| q[a] as f64 - p[a]);
-            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            (d.map(|x| x / n), n)
-        }
-    };
-    let bmax = grid.max_corner();
-    let mut t1 = dist;
-    for a in 0..3 {
-        let inv = 1.0 / dir[a];
-        let (ta, tb) = (
-            (grid.origin[a] as f64 - p[a]) * inv,
-            (bmax[a] as f64 - p[a]) * inv,
-        );
-        t1 = t1.min(ta.max(tb));
-    }
-    let h = grid.spacing as f64;
-    let n = (t1.max(0.0) / h / dv).ceil() as usize;
-    let dt = t1.max(0.0) / n.max(1) as f64;
-    let mut sum = 0.0;
-    for i in 0..n {
-        let t = (i as f64 + 0.5) * dt;
-        let x = (field([p[0] + dir[0] * t, p[1] + dir[1] * t, p[2] + dir[2] * t]) - lo) / (hi - lo)
-            * 255.0;
-        sum += tf::extinction(tf.eval(x)[3]) * dt / h;
-    }
-    (-sum).exp()
-}
-
 #[test]
 fn volumetric_shadows_match_double_precision_reference() {
     // Atom A at the origin, an occluder B 4.5 Å above it (the supports, √2·r = 2.1 Å, do
@@ -428,6 +332,7 @@ fn volumetric_shadows_match_double_precision_reference() {
     let hi = v.max_value;
     let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);
     let field = |q: [f64; 3]| phi(&atoms, q);
+    let reference = Reference::new(&field, &tf, hi, &v.grid);
     let b = atom_rays(f32::INFINITY);
     let ambient = 0.3;
     for light in [
@@ -439,36 +344,11 @@ fn volumetric_shadows_match_double_precision_reference() {
             step_voxels: 0.5,
         };
         let shade = |q: [f64; 3]| {
-            let t = reference_transmittance(&field, &tf, 0.0, hi as f64, &v.grid, q, light, 0.05);
+            let t = reference.transmittance(q, light, 0.05);
             ambient + (1.0 - ambient) * t
         };
-        let want: Vec<[f64; 4]> = (0..b.tmax.len())
-            .map(|i| {
-                let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-                let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-                let tm = b.tmax[i] as f64;
-                reference_shaded(&field, &tf, 0.0, hi as f64, &v.grid, o, d, tm, 0.01, &shade)
-            })
-            .collect();
-        let unshadowed: Vec<[f64; 4]> = (0..b.tmax.len())
-            .map(|i| {
-                let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-                let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-                let tm = b.tmax[i] as f64;
-                reference_shaded(
-                    &field,
-                    &tf,
-                    0.0,
-                    hi as f64,
-                    &v.grid,
-                    o,
-                    d,
-                    tm,
-                    0.01,
-                    &|_| 1.0,
-                )
-            })
-            .collect();
+        let want = reference.batch(&b, 0.01, &shade);
+        let unshadowed = reference.batch(&b, 0.01, &unshaded);
         // The shadows must matter: B darkens A by a lot on some rays, not on others.
         let darkening: Vec<f64> = want
             .iter()
@@ -530,12 +410,7 @@ fn light_volume_is_the_shadow_rays_on_a_shell() {
     // worst 13.1/255, mean 1.3/255 per channel.
     for format in [VolumeFormat::U8, VolumeFormat::F32] {
         let (v, mc) = shell_scene(format);
-        let ctf = ClassifiedTf::new(
-            &TransferFunction::preset(Preset::CoolWarm),
-            0.0,
-            v.max_value,
-            0.5,
-        );
+        let ctf = preset_tf(Preset::CoolWarm, v.max_value);
         let b = scattered_rays(203, 5);
         for lighting in [Lighting::Unlit, Lighting::Directional([1.0, 0.3, 0.2])] {
             let shadows = VolumeShadows {

@@ -109,35 +109,20 @@ fn single_atom_matches_the_closed_form_integrated_in_double_precision() {
         }
     };
     let b = atom_rays(f32::INFINITY);
-    let want: Vec<[f64; 4]> = (0..b.tmax.len())
-        .map(|i| {
-            let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-            let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-            reference(&field, &tf, 0.0, hi as f64, &p.grid, o, d, b.tmax[i] as f64)
-        })
-        .collect();
+    let reference = Reference::new(&field, &tf, hi, &p.grid);
+    let want = reference.batch(&b, 0.002, &unshaded);
     assert!(want.iter().filter(|w| w[3] > 0.2).count() > 10);
     assert!(want.iter().filter(|w| w[3] == 0.0).count() > 3);
     // (Pre-integrated: 2/255, the 0.99 opacity cut-off stops rays the reference goes on with.)
-    for (preintegrated, tol) in [(true, 2.0 / 255.0), (false, 8.0 / 255.0)] {
-        for macrocells in [true, false] {
-            let opts = MarchOptions {
-                preintegrated,
-                macrocells,
-                ..Default::default()
-            };
-            let sc = ParticleScene::new(&p, &ctf, opts);
-            for isa in Isa::supported() {
-                let e = max_err(&b.render_particles(isa, &sc), &want);
-                eprintln!(
-                    "preint {preintegrated} skip {macrocells} {isa}: {:.2}/255",
-                    e * 255.0
-                );
-                assert!(
-                    e <= tol,
-                    "preint {preintegrated} skip {macrocells} {isa}: {e}"
-                );
-            }
+    for (opts, tol, label) in classification_opts(2.0 / 255.0, 8.0 / 255.0) {
+        let sc = ParticleScene::new(&p, &ctf, opts);
+        for isa in Isa::supported() {
+            assert_near(
+                &format!("{label} {isa}"),
+                &b.render_particles(isa, &sc),
+                &want,
+                tol,
+            );
         }
     }
 }
@@ -151,35 +136,25 @@ fn random_atoms_match_the_brute_force_sum_along_each_ray_lit_and_unlit() {
     let hi = p.max_value;
     let ctf = ClassifiedTf::new(&tf, 0.0, hi, 0.5);
     let field = |q: [f64; 3]| phi(&a, q);
+    let reference = Reference::new(&field, &tf, hi, &p.grid);
     let b = cluster_rays(120, 6.0, 21);
     let light = [1.0f64, 2.0, 0.5];
     for lighting in [Lighting::Unlit, Lighting::Directional([1.0, 2.0, 0.5])] {
-        let want: Vec<[f64; 4]> = (0..b.tmax.len())
-            .map(|i| {
-                let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-                let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-                let shade = |q: [f64; 3]| match lighting {
-                    Lighting::Unlit => 1.0,
-                    _ => {
-                        let g = grad_phi(&a, q);
-                        let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-                        let ll = (light[0] * light[0] + light[1] * light[1] + light[2] * light[2])
-                            .sqrt();
-                        let f = if gl > 1e-10 {
-                            ((g[0] * light[0] + g[1] * light[1] + g[2] * light[2]) / (gl * ll))
-                                .abs()
-                        } else {
-                            1.0
-                        };
-                        0.3 + 0.7 * f
-                    }
+        let shade = |q: [f64; 3]| match lighting {
+            Lighting::Unlit => 1.0,
+            _ => {
+                let g = grad_phi(&a, q);
+                let gl = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+                let ll = (light[0] * light[0] + light[1] * light[1] + light[2] * light[2]).sqrt();
+                let f = if gl > 1e-10 {
+                    ((g[0] * light[0] + g[1] * light[1] + g[2] * light[2]) / (gl * ll)).abs()
+                } else {
+                    1.0
                 };
-                let tmax = b.tmax[i] as f64;
-                reference_shaded(
-                    &field, &tf, 0.0, hi as f64, &p.grid, o, d, tmax, 0.02, &shade,
-                )
-            })
-            .collect();
+                0.3 + 0.7 * f
+            }
+        };
+        let want = reference.batch(&b, 0.02, &shade);
         assert!(want.iter().filter(|w| w[3] > 0.2).count() > 20);
         let opts = MarchOptions {
             lighting,
@@ -187,9 +162,8 @@ fn random_atoms_match_the_brute_force_sum_along_each_ray_lit_and_unlit() {
         };
         let sc = ParticleScene::new(&p, &ctf, opts);
         for isa in Isa::supported() {
-            let e = max_err(&b.render_particles(isa, &sc), &want);
-            eprintln!("{lighting:?} {isa}: {:.2}/255", e * 255.0);
-            assert!(e <= 3.0 / 255.0, "{lighting:?} {isa}: {e}");
+            let what = format!("{lighting:?} {isa}");
+            assert_near(&what, &b.render_particles(isa, &sc), &want, 3.0 / 255.0);
         }
     }
 }
@@ -232,7 +206,7 @@ fn particles_match_the_grid_path_at_4_voxels_per_angstrom() {
     let field = |q: [f64; 3]| phi(&a, q);
     for preset in [Preset::CoolWarm, Preset::Viridis] {
         let tf = TransferFunction::preset(preset);
-        let ctf = ClassifiedTf::new(&tf, 0.0, v.max_value, 0.5);
+        let ctf = preset_tf(preset, v.max_value);
         for lighting in [Lighting::Unlit, Lighting::Headlight] {
             let opts = MarchOptions {
                 lighting,
@@ -262,22 +236,10 @@ fn particles_match_the_grid_path_at_4_voxels_per_angstrom() {
             }
             // Every fifth ray against the exact field integrated in f64.
             let (mut eg, mut ep) = (0.0f64, 0.0f64);
+            let reference = Reference::new(&field, &tf, v.max_value, &v.grid);
             for i in (0..b.tmax.len()).step_by(5) {
-                let o = [b.o[0][i] as f64, b.o[1][i] as f64, b.o[2][i] as f64];
-                let d = [b.d[0][i] as f64, b.d[1][i] as f64, b.d[2][i] as f64];
-                let tmax = b.tmax[i] as f64;
-                let w = reference_shaded(
-                    &field,
-                    &tf,
-                    0.0,
-                    v.max_value as f64,
-                    &v.grid,
-                    o,
-                    d,
-                    tmax,
-                    0.05,
-                    &|_| 1.0,
-                );
+                let (o, d, tmax) = b.ray64(i);
+                let w = reference.ray(o, d, tmax, 0.05, &unshaded);
                 eg += max_err(&grid[i..=i], &[w]);
                 ep += max_err(&part[i..=i], &[w]);
             }
@@ -297,12 +259,7 @@ fn particles_match_the_grid_path_at_4_voxels_per_angstrom() {
 fn every_backend_agrees_with_scalar_and_skipping_changes_nothing() {
     let a = shell(9.0);
     let p = particles_of(&a, 3.0);
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::Viridis),
-        0.0,
-        p.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::Viridis, p.max_value);
     let b = scattered_rays(203, 9); // not a multiple of any lane count
     for lighting in [
         Lighting::Unlit,
@@ -324,14 +281,8 @@ fn every_backend_agrees_with_scalar_and_skipping_changes_nothing() {
             for isa in Isa::supported() {
                 for opts in [on, off] {
                     let got = b.render_particles(isa, &ParticleScene::new(&p, &ctf, opts));
-                    for (i, (x, y)) in got.iter().zip(&want).enumerate() {
-                        for c in 0..4 {
-                            assert!(
-                                (x[c] - y[c]).abs() <= 1e-5,
-                                "{isa} {opts:?} ray {i}: {x:?} vs scalar without skipping {y:?}"
-                            );
-                        }
-                    }
+                    let what = |_| format!("{isa} {opts:?} against scalar without skipping");
+                    assert_agree(&got, &want, 1e-5, &what);
                 }
             }
         }
@@ -342,12 +293,7 @@ fn every_backend_agrees_with_scalar_and_skipping_changes_nothing() {
 fn degenerate_rays_opaque_depth_and_bad_atoms() {
     let a = shell(9.0);
     let p = particles_of(&a, 2.0);
-    let ctf = ClassifiedTf::new(
-        &TransferFunction::preset(Preset::CoolWarm),
-        0.0,
-        p.max_value,
-        0.5,
-    );
+    let ctf = preset_tf(Preset::CoolWarm, p.max_value);
     let sc = ParticleScene::new(&p, &ctf, MarchOptions::default());
     let mut b = Batch::new();
     let nan = f64::NAN;

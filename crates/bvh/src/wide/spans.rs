@@ -4,7 +4,7 @@
 use spmd::{Simd, V3};
 
 use super::WideBvh;
-use crate::spans::{chord, Span};
+use crate::spans::{Span, SpanQuery};
 use crate::traverse::{slab_test, BOX_GROW};
 use crate::tree::Bvh;
 
@@ -25,11 +25,9 @@ impl WideBvh {
         out: &mut Vec<Span>,
     ) {
         assert_eq!(self.records, bvh.records.len(), "wide BVH of another tree");
-        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        let finite = o.iter().chain(d.iter()).all(|v| v.is_finite());
-        if !(finite && dd > 0.0 && dd.is_finite() && t_lo <= t_hi) || self.nodes.is_empty() {
+        let Some(q) = SpanQuery::new(o, d, t_lo, t_hi).filter(|_| !self.nodes.is_empty()) else {
             return;
-        }
+        };
         let ov: V3<S> = V3::splat(s, o);
         let inv: V3<S> = V3::new(
             s.rcp(s.splat(d[0])),
@@ -48,37 +46,14 @@ impl WideBvh {
             if e & LEAF != 0 {
                 sp -= 1;
                 let (first, count) = ((e & !LEAF) as usize, stack[sp] as usize);
-                for slot in first..first + count {
-                    let rec = &bvh.records[slot];
-                    if !rec.is_sphere() {
-                        continue;
-                    }
-                    if let Some((t0, t1)) = chord(o, d, dd, rec.p0, rec.r) {
-                        if t0 <= t_hi && t1 >= t_lo {
-                            out.push(Span {
-                                t0,
-                                t1,
-                                slot: slot as u32,
-                            });
-                        }
-                    }
-                }
+                q.leaf(&bvh.records, first..first + count, out);
                 continue;
             }
             let node = &self.nodes[e as usize];
             let n = node.n as usize;
             let mut c = 0usize;
             while c < n {
-                let lo = V3::new(
-                    s.load_partial(&node.min[0][c..], 0.0),
-                    s.load_partial(&node.min[1][c..], 0.0),
-                    s.load_partial(&node.min[2][c..], 0.0),
-                );
-                let hi = V3::new(
-                    s.load_partial(&node.max[0][c..], 0.0),
-                    s.load_partial(&node.max[1][c..], 0.0),
-                    s.load_partial(&node.max[2][c..], 0.0),
-                );
+                let (lo, hi) = node.boxes(s, c);
                 let (m, _) = slab_test(s, lo, hi, ov, inv, lo_t, hi_t, grow);
                 let mut bits = s.bitmask(m & s.first_n(n - c));
                 while bits != 0 {

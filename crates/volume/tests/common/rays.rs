@@ -32,6 +32,20 @@ impl Batch {
             tmax: &self.tmax,
         }
     }
+    /// Ray `i` in f64: origin, direction, opaque depth.
+    pub fn ray64(&self, i: usize) -> ([f64; 3], [f64; 3], f64) {
+        let o = [
+            self.o[0][i] as f64,
+            self.o[1][i] as f64,
+            self.o[2][i] as f64,
+        ];
+        let d = [
+            self.d[0][i] as f64,
+            self.d[1][i] as f64,
+            self.d[2][i] as f64,
+        ];
+        (o, d, self.tmax[i] as f64)
+    }
     pub fn render(&self, isa: Isa, sc: &VolumeScene) -> Vec<[f32; 4]> {
         let mut out = vec![[0.0; 4]; self.tmax.len()];
         march_rays(isa, sc, &self.rays(), &mut out);
@@ -44,70 +58,181 @@ impl Batch {
     }
 }
 
-/// Front-to-back emission-absorption along the ray in f64, step `dv` voxels, classification
-/// = linear interpolation of the entries of `tf` over [lo, hi], opacity per voxel.
-#[allow(clippy::too_many_arguments)]
-pub fn reference(
-    field: &dyn Fn([f64; 3]) -> f64,
-    tf: &TransferFunction,
-    lo: f64,
-    hi: f64,
-    grid: &Grid,
-    o: [f64; 3],
-    d: [f64; 3],
-    tmax: f64,
-) -> [f64; 4] {
-    reference_shaded(field, tf, lo, hi, grid, o, d, tmax, 0.002, &|_| 1.0)
+/// The double-precision reference the marchers are tested against: an analytic `field`
+/// classified by `tf` over `[lo, hi]` (linear interpolation of its entries, opacity per voxel
+/// of `grid`), inside `grid`'s box.
+pub struct Reference<'a> {
+    pub field: &'a dyn Fn([f64; 3]) -> f64,
+    pub tf: &'a TransferFunction,
+    pub lo: f64,
+    pub hi: f64,
+    pub grid: &'a Grid,
 }
 
-/// As [`reference`] with step `dv` voxels and each sample's colour scaled by `shade(p)`.
-#[allow(clippy::too_many_arguments)]
-pub fn reference_shaded(
-    field: &dyn Fn([f64; 3]) -> f64,
-    tf: &TransferFunction,
-    lo: f64,
-    hi: f64,
-    grid: &Grid,
-    o: [f64; 3],
-    d: [f64; 3],
-    tmax: f64,
-    dv: f64,
-    shade: &dyn Fn([f64; 3]) -> f64,
-) -> [f64; 4] {
-    let h = grid.spacing as f64;
-    let bmax = grid.max_corner();
-    let (mut t0, mut t1) = (0.0f64, tmax);
-    for a in 0..3 {
-        let inv = 1.0 / d[a];
-        let (ta, tb) = (
-            (grid.origin[a] as f64 - o[a]) * inv,
-            (bmax[a] as f64 - o[a]) * inv,
-        );
-        t0 = t0.max(ta.min(tb));
-        t1 = t1.min(ta.max(tb));
-    }
-    let mut c = [0.0f64; 3];
-    let mut trans = 1.0f64;
-    if t0 >= t1 {
-        return [0.0; 4];
-    }
-    let dl = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let n = ((t1 - t0) * dl / h / dv).ceil() as usize;
-    let dt = (t1 - t0) / n as f64;
-    let step_vox = dt * dl / h;
-    for i in 0..n {
-        let t = t0 + (i as f64 + 0.5) * dt;
-        let p = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
-        let x = (field(p) - lo) / (hi - lo) * 255.0;
-        let e = tf.eval(x);
-        let a = 1.0 - (-step_vox * tf::extinction(e[3])).exp();
-        let f = if a > 0.0 { shade(p) } else { 1.0 };
-        for ch in 0..3 {
-            c[ch] += trans * e[ch] * a * f;
+impl<'a> Reference<'a> {
+    /// `field` classified by `tf` over `[0, hi]` inside `grid`'s box.
+    pub fn new(
+        field: &'a dyn Fn([f64; 3]) -> f64,
+        tf: &'a TransferFunction,
+        hi: f32,
+        grid: &'a Grid,
+    ) -> Self {
+        Reference {
+            field,
+            tf,
+            lo: 0.0,
+            hi: hi as f64,
+            grid,
         }
-        trans *= 1.0 - a;
     }
-    [c[0], c[1], c[2], 1.0 - trans]
+
+    /// The part `[t0, t1]` of `[t_lo, t_hi]` where `p + t·dir` is inside the box.
+    pub fn clip(&self, p: [f64; 3], dir: [f64; 3], t_lo: f64, t_hi: f64) -> (f64, f64) {
+        let g = self.grid;
+        let bmax = g.max_corner();
+        let (mut t0, mut t1) = (t_lo, t_hi);
+        for a in 0..3 {
+            let inv = 1.0 / dir[a];
+            let (ta, tb) = (
+                (g.origin[a] as f64 - p[a]) * inv,
+                (bmax[a] as f64 - p[a]) * inv,
+            );
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        (t0, t1)
+    }
+
+    /// Transfer-function entry of the field at `p`.
+    fn classify(&self, p: [f64; 3]) -> [f64; 4] {
+        self.tf
+            .eval(((self.field)(p) - self.lo) / (self.hi - self.lo) * 255.0)
+    }
+
+    /// Front-to-back emission-absorption along the ray (midpoint rule, step `dv` voxels),
+    /// each sample's colour scaled by `shade(p)`.
+    pub fn ray(
+        &self,
+        o: [f64; 3],
+        d: [f64; 3],
+        tmax: f64,
+        dv: f64,
+        shade: &dyn Fn([f64; 3]) -> f64,
+    ) -> [f64; 4] {
+        let (t0, t1) = self.clip(o, d, 0.0, tmax);
+        if t0 >= t1 {
+            return [0.0; 4];
+        }
+        let h = self.grid.spacing as f64;
+        let dl = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let n = ((t1 - t0) * dl / h / dv).ceil() as usize;
+        let dt = (t1 - t0) / n as f64;
+        let step_vox = dt * dl / h;
+        let (mut c, mut trans) = ([0.0f64; 3], 1.0f64);
+        for i in 0..n {
+            let t = t0 + (i as f64 + 0.5) * dt;
+            let p = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
+            let e = self.classify(p);
+            let a = 1.0 - (-step_vox * tf::extinction(e[3])).exp();
+            let f = if a > 0.0 { shade(p) } else { 1.0 };
+            for ch in 0..3 {
+                c[ch] += trans * e[ch] * a * f;
+            }
+            trans *= 1.0 - a;
+        }
+        [c[0], c[1], c[2], 1.0 - trans]
+    }
+
+    /// [`Reference::ray`] for every ray of `b`.
+    pub fn batch(&self, b: &Batch, dv: f64, shade: &dyn Fn([f64; 3]) -> f64) -> Vec<[f64; 4]> {
+        (0..b.tmax.len())
+            .map(|i| {
+                let (o, d, tmax) = b.ray64(i);
+                self.ray(o, d, tmax, dv, shade)
+            })
+            .collect()
+    }
+
+    /// Transmittance from `p` towards `light` to the box's exit (or the point light):
+    /// midpoint rule with steps of `dv` voxels.
+    pub fn transmittance(&self, p: [f64; 3], light: Light, dv: f64) -> f64 {
+        let (dir, dist) = match light {
+            Light::Directional(l) => {
+                let l = l.map(|x| x as f64);
+                let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+                (l.map(|x| x / n), f64::INFINITY)
+            }
+            Light::Point(q) => {
+                let d: [f64; 3] = core::array::from_fn(|a| q[a] as f64 - p[a]);
+                let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                (d.map(|x| x / n), n)
+            }
+        };
+        let t1 = self.clip(p, dir, 0.0, dist).1.max(0.0);
+        let h = self.grid.spacing as f64;
+        let n = (t1 / h / dv).ceil() as usize;
+        let dt = t1 / n.max(1) as f64;
+        let mut sum = 0.0;
+        for i in 0..n {
+            let t = (i as f64 + 0.5) * dt;
+            let e = self.classify([p[0] + dir[0] * t, p[1] + dir[1] * t, p[2] + dir[2] * t]);
+            sum += tf::extinction(e[3]) * dt / h;
+        }
+        (-sum).exp()
+    }
+}
+
+/// Asserts `got` within `tol` (any channel) of the reference `want`, printing the error
+/// in 1/255 under the label `what`.
+pub fn assert_near(what: &str, got: &[[f32; 4]], want: &[[f64; 4]], tol: f64) {
+    let e = max_err(got, want);
+    eprintln!("{what}: max error {e:.5} ({:.2}/255)", e * 255.0);
+    assert!(e <= tol, "{what}: max error {e} over {tol}");
+}
+
+/// Default options with classification (pre-integrated or post) and empty-space skipping
+/// (on or off) in every combination, each with its tolerance (`preint` or `post`) and a label.
+pub fn classification_opts(preint: f64, post: f64) -> Vec<(MarchOptions, f64, String)> {
+    let mut v = Vec::new();
+    for (preintegrated, tol) in [(true, preint), (false, post)] {
+        for macrocells in [true, false] {
+            let opts = MarchOptions {
+                preintegrated,
+                macrocells,
+                ..Default::default()
+            };
+            v.push((
+                opts,
+                tol,
+                format!("preint {preintegrated} skip {macrocells}"),
+            ));
+        }
+    }
+    v
+}
+
+/// Unshaded samples.
+pub fn unshaded(_: [f64; 3]) -> f64 {
+    1.0
+}
+
+/// Asserts `got` within `tol` of `want` channel by channel, naming the ray with `what(i)`.
+pub fn assert_agree(got: &[[f32; 4]], want: &[[f32; 4]], tol: f32, what: &dyn Fn(usize) -> String) {
+    assert_eq!(got.len(), want.len());
+    for (i, (x, y)) in got.iter().zip(want).enumerate() {
+        for c in 0..4 {
+            assert!(
+                (x[c] - y[c]).abs() <= tol,
+                "{} ray {i}: {x:?} vs {y:?}",
+                what(i)
+            );
+        }
+    }
+}
+
+/// `preset` classified over `[0, hi]` for steps of half a voxel.
+pub fn preset_tf(preset: Preset, hi: f32) -> ClassifiedTf {
+    ClassifiedTf::new(&TransferFunction::preset(preset), 0.0, hi, 0.5)
 }
 
 pub fn max_err(a: &[[f32; 4]], b: &[[f64; 4]]) -> f64 {

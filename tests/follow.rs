@@ -9,17 +9,12 @@ use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-use common::{bnsview, refused, run, sample, scratch};
+use common::{bnsview, generate_frames, refused, run, sample, scratch};
 
 /// A 4-frame generated dump, written whole to `dir/whole.lammpstrj`; the text of each frame.
 fn frames(dir: &Path) -> Vec<String> {
     let whole = dir.join("whole.lammpstrj");
-    let (ok, _, err) = run(bnsview()
-        .args([
-            "generate", "nanobowl", "--atoms", "300", "--frames", "4", "-o",
-        ])
-        .arg(&whole));
-    assert!(ok, "{err}");
+    generate_frames(&whole, 300, 4);
     let text = std::fs::read_to_string(&whole).unwrap();
     let starts: Vec<usize> = text
         .match_indices("ITEM: TIMESTEP")

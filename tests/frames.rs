@@ -4,7 +4,7 @@ mod common;
 
 use std::process::Command;
 
-use common::{bnsview, run, sample, scratch};
+use common::{bnsview, generate_frames, run, sample, scratch};
 
 #[test]
 fn frames_of_a_trajectory_equal_single_frames_with_the_printed_camera_and_range() {
@@ -116,12 +116,7 @@ fn frames_of_a_trajectory_equal_single_frames_with_the_printed_camera_and_range(
 fn generate_writes_a_trajectory_of_the_frames_asked_for() {
     let d = scratch("genframes");
     let out = d.join("t.lammpstrj.gz");
-    let (ok, _, err) = run(bnsview()
-        .args([
-            "generate", "nanobowl", "--atoms", "500", "--frames", "4", "-o",
-        ])
-        .arg(&out));
-    assert!(ok, "{err}");
+    generate_frames(&out, 500, 4);
     let (ok, info, err) = run(bnsview().arg("info").arg(&out));
     assert!(ok && info.contains("frames:    4"), "{info}{err}");
     // The frames move (jitter and breathing) and are the same again for the same seed.
@@ -137,12 +132,7 @@ fn generate_writes_a_trajectory_of_the_frames_asked_for() {
     };
     assert_ne!(render("0", "a.png"), render("3", "b.png"));
     let again = d.join("again.lammpstrj.gz");
-    let (ok, _, err) = run(bnsview()
-        .args([
-            "generate", "nanobowl", "--atoms", "500", "--frames", "4", "-o",
-        ])
-        .arg(&again));
-    assert!(ok, "{err}");
+    generate_frames(&again, 500, 4);
     let gunzip = |p: &std::path::Path| {
         let mut s = String::new();
         std::io::Read::read_to_string(

@@ -48,3 +48,13 @@ pub fn refused(c: &mut Command, wants: &[&str]) -> String {
     }
     err
 }
+
+/// Writes a generated nanobowl trajectory of `atoms` atoms and `frames` frames (seed 1) to
+/// `out` with `bnsview generate`, as a user would; panics with its stderr if it fails.
+pub fn generate_frames(out: &std::path::Path, atoms: usize, frames: usize) {
+    let (ok, _, err) = run(bnsview()
+        .args(["generate", "nanobowl", "--atoms", &atoms.to_string()])
+        .args(["--frames", &frames.to_string(), "-o"])
+        .arg(out));
+    assert!(ok, "generate {}: {err}", out.display());
+}

@@ -77,6 +77,7 @@
 
 #![warn(missing_docs)]
 
+mod gradient;
 pub mod grid;
 pub mod light;
 pub mod macrocell;

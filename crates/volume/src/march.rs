@@ -18,12 +18,12 @@
 
 use spmd::{Isa, Kernel, Simd, V3};
 
+use crate::gradient::{diffuse_stencil, sample_stencil};
 use crate::macrocell::MACROCELL;
 use crate::medium::Medium;
 pub use crate::sampler::sample_points;
 use crate::sampler::{
-    bin, cell_occupied, clip_box, diffuse, trilinear, with_lattice, GridRay, Lattice, OnLattice,
-    Voxels,
+    bin, cell_occupied, clip_box, trilinear, with_lattice, GridRay, Lattice, OnLattice, Voxels,
 };
 use crate::scene::Light;
 pub use crate::scene::{Lighting, MarchOptions, VolumeScene, VolumeShadows};
@@ -294,7 +294,17 @@ fn march_impl<S: Simd, V: Voxels>(
         }
         let tb = s.min(tk + dt, t_end);
         let frac = (tb - tk) / dt;
-        let sb = trilinear(s, lat, og.mul_add(dg, tb), valid);
+        let pg = og.mul_add(dg, tb);
+        // Lit: the sample from the rows its gradient needs too (gradient.rs).
+        let stencil = if lit {
+            Some(sample_stencil(s, lat, pg, valid))
+        } else {
+            None
+        };
+        let sb = match &stencil {
+            Some(st) => st.value,
+            None => trilinear(s, lat, pg, valid),
+        };
         let front = valid & s.ne(prev_k, k);
         if preint && s.any(front) {
             let sf = trilinear(s, lat, og.mul_add(dg, tk), front);
@@ -304,14 +314,13 @@ fn march_impl<S: Simd, V: Voxels>(
         if lit || shadows.is_some() {
             let shading = valid & s.gt(c[3], zero);
             if s.any(shading) {
-                let pg = og.mul_add(dg, tb);
                 let mut f = one;
-                if lit {
+                if let Some(st) = &stencil {
                     let l = match shade_light {
                         Some(light) => light.towards(s, pg).0,
                         None => headlight,
                     };
-                    f = diffuse(s, lat, pg, l, shading);
+                    f = diffuse_stencil(s, lat, st, pg, l, shading);
                 }
                 if let Some((light, step)) = shadows {
                     f *= match scene.light {

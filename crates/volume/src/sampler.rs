@@ -19,6 +19,8 @@ pub(crate) trait Voxels: Copy {
     /// `m ? (value[idx], value[idx + 1]) : (0, 0)`: two x-neighbours (raw: quantised units for
     /// u8).
     fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32);
+    /// `m ? value[idx .. idx + 4] : 0`: four x-neighbours (raw units).
+    fn fetch4<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> [S::F32; 4];
 }
 
 /// f32 voxels (density units).
@@ -35,6 +37,12 @@ impl Voxels for F32Voxels<'_> {
         let a = s.gather(self.0, idx, m, z);
         (a, s.gather(self.0, idx + s.splat_i(1), m, z))
     }
+    #[inline(always)]
+    fn fetch4<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> [S::F32; 4] {
+        let (a, b) = self.fetch2(s, idx, m);
+        let (c, d) = self.fetch2(s, idx + s.splat_i(2), m);
+        [a, b, c, d]
+    }
 }
 impl Voxels for U8Voxels<'_> {
     // One 4-byte gather serves both neighbours (8 → 4 gathers per sample): ns740k far
@@ -45,20 +53,34 @@ impl Voxels for U8Voxels<'_> {
         let ff = s.splat_i(0xff);
         (s.to_f32(w & ff), s.to_f32(s.shr(w, 8) & ff))
     }
+    // The same single 4-byte gather, all four bytes used.
+    #[inline(always)]
+    fn fetch4<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> [S::F32; 4] {
+        let w = s.gather_u8x4(self.0, idx, m);
+        let ff = s.splat_i(0xff);
+        [
+            s.to_f32(w & ff),
+            s.to_f32(s.shr(w, 8) & ff),
+            s.to_f32(s.shr(w, 16) & ff),
+            s.to_f32(s.shr(w, 24) & ff),
+        ]
+    }
 }
 
 /// Uniform lattice facts the sampler needs.
 #[derive(Clone, Copy)]
 pub(crate) struct Lattice<V> {
-    vox: V,
+    pub(crate) vox: V,
     /// Largest grid coordinate per axis (`dims − 1`).
     pub(crate) hi: [f32; 3],
     /// Largest base index per axis (`dims − 2`).
-    base_hi: [f32; 3],
-    nx: i32,
-    nxy: i32,
+    pub(crate) base_hi: [f32; 3],
+    /// Index step along y (`dims[0]`).
+    pub(crate) nx: i32,
+    /// Index step along z (`dims[0]·dims[1]`).
+    pub(crate) nxy: i32,
     /// Raw → density units.
-    scale: f32,
+    pub(crate) scale: f32,
 }
 
 impl<V: Voxels> Lattice<V> {
@@ -196,37 +218,65 @@ pub(crate) fn clip_box<S: Simd>(
 
 /// `a + (b − a)·t`.
 #[inline(always)]
-fn lerp<S: Simd>(a: S::F32, b: S::F32, t: S::F32) -> S::F32 {
+pub(crate) fn lerp<S: Simd>(a: S::F32, b: S::F32, t: S::F32) -> S::F32 {
     a + (b - a) * t
+}
+
+/// The lattice cell a trilinear sample reads: index of its lower corner, the fractions
+/// (voxels) and the corner's coordinates.
+pub(crate) struct Cell<S: Simd> {
+    /// Index of lattice point `(ix, iy, iz)`.
+    pub(crate) b: S::I32,
+    /// Position inside the cell per axis, in `[0, 1]`.
+    pub(crate) f: [S::F32; 3],
+    /// Lower corner per axis (`0 ..= dims − 2`).
+    pub(crate) i: [S::F32; 3],
+}
+
+// Paper §4.4: the cell of grid position `p`, clamped to the box (a point on the upper face
+// takes the last cell with fraction 1).
+#[inline(always)]
+pub(crate) fn cell_of<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>) -> Cell<S> {
+    let pa = [p.x, p.y, p.z];
+    let zero = s.splat(0.0);
+    let mut f = [zero; 3];
+    let mut i = [zero; 3];
+    for a in 0..3 {
+        let q = s.min(s.max(pa[a], zero), s.splat(l.hi[a]));
+        i[a] = s.min(s.floor(q), s.splat(l.base_hi[a]));
+        f[a] = q - i[a];
+    }
+    let b = s.to_i32(i[0])
+        + s.mul_i(s.to_i32(i[1]), s.splat_i(l.nx))
+        + s.mul_i(s.to_i32(i[2]), s.splat_i(l.nxy));
+    Cell { b, f, i }
+}
+
+/// Trilinear blend of the eight corner values `v[z][y][x]` with fractions `f`.
+#[inline(always)]
+pub(crate) fn blend<S: Simd>(v: [[[S::F32; 2]; 2]; 2], f: [S::F32; 3]) -> S::F32 {
+    let x00 = lerp::<S>(v[0][0][0], v[0][0][1], f[0]);
+    let x10 = lerp::<S>(v[0][1][0], v[0][1][1], f[0]);
+    let x01 = lerp::<S>(v[1][0][0], v[1][0][1], f[0]);
+    let x11 = lerp::<S>(v[1][1][0], v[1][1][1], f[0]);
+    let y0 = lerp::<S>(x00, x10, f[1]);
+    let y1 = lerp::<S>(x01, x11, f[1]);
+    lerp::<S>(y0, y1, f[2])
 }
 
 // Paper §4.4: trilinear interpolation at grid coordinates `p` (clamped to the box), seven
 // lerps, four paired gathers.
 #[inline(always)]
 pub(crate) fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::F32 {
-    let zero = s.splat(0.0);
-    let px = s.min(s.max(p.x, zero), s.splat(l.hi[0]));
-    let py = s.min(s.max(p.y, zero), s.splat(l.hi[1]));
-    let pz = s.min(s.max(p.z, zero), s.splat(l.hi[2]));
-    let ix = s.min(s.floor(px), s.splat(l.base_hi[0]));
-    let iy = s.min(s.floor(py), s.splat(l.base_hi[1]));
-    let iz = s.min(s.floor(pz), s.splat(l.base_hi[2]));
-    let (fx, fy, fz) = (px - ix, py - iy, pz - iz);
-    let nx = s.splat_i(l.nx);
-    let nxy = s.splat_i(l.nxy);
-    let b = s.to_i32(ix) + s.mul_i(s.to_i32(iy), nx) + s.mul_i(s.to_i32(iz), nxy);
-    let (v000, v100) = l.vox.fetch2(s, b, m);
-    let (v010, v110) = l.vox.fetch2(s, b + nx, m);
-    let b1 = b + nxy;
+    let c = cell_of(s, l, p);
+    let (nx, nxy) = (s.splat_i(l.nx), s.splat_i(l.nxy));
+    let (v000, v100) = l.vox.fetch2(s, c.b, m);
+    let (v010, v110) = l.vox.fetch2(s, c.b + nx, m);
+    let b1 = c.b + nxy;
     let (v001, v101) = l.vox.fetch2(s, b1, m);
     let (v011, v111) = l.vox.fetch2(s, b1 + nx, m);
-    let x00 = lerp::<S>(v000, v100, fx);
-    let x10 = lerp::<S>(v010, v110, fx);
-    let x01 = lerp::<S>(v001, v101, fx);
-    let x11 = lerp::<S>(v011, v111, fx);
-    let y0 = lerp::<S>(x00, x10, fy);
-    let y1 = lerp::<S>(x01, x11, fy);
-    lerp::<S>(y0, y1, fz) * s.splat(l.scale)
+    let v = [[[v000, v100], [v010, v110]], [[v001, v101], [v011, v111]]];
+    blend::<S>(v, c.f) * s.splat(l.scale)
 }
 
 /// `p + (dx, dy, dz)` (voxels).
@@ -236,7 +286,8 @@ fn offset<S: Simd>(s: S, p: V3<S>, dx: f32, dy: f32, dz: f32) -> V3<S> {
 }
 
 // Paper §4.4 (gradient shading): diffuse factor |n·l|, n the normalised central-difference
-// gradient at grid position `p` (1 where the gradient vanishes).
+// gradient at grid position `p` from six trilinear samples (1 where the gradient vanishes);
+// the marcher reads it from one stencil (gradient.rs) and comes here only at the border.
 #[inline(always)]
 pub(crate) fn diffuse<S: Simd, V: Voxels>(
     s: S,

@@ -16,8 +16,9 @@ pub enum Lighting {
     #[default]
     Unlit,
     /// Diffuse, two-sided, light at the eye: colour × (a + (1 − a)·|n·v|), `n` the normalised
-    /// gradient by central differences (6 extra trilinear samples per lit sample), `a` the
-    /// ambient term of [`MarchOptions`] (0.3).
+    /// gradient by central differences (one voxel each way; the trilinear interpolant of the
+    /// lattice's central differences, eight extra gathers per shaded sample), `a` the ambient
+    /// term of [`MarchOptions`] (0.3).
     Headlight,
     /// As `Headlight` with a fixed direction towards the light (world space, need not be unit).
     Directional([f32; 3]),

@@ -26,7 +26,7 @@ mod traverse;
 mod tree;
 mod wide;
 
-pub use build::{BuildOptions, MAX_BINS};
+pub use build::{BuildOptions, CLUSTER_ABOVE, CLUSTER_UPTO, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{
     end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,

@@ -1,7 +1,7 @@
 //! Builders: structure (validate), SAH quality of binned vs full sweep, degenerate inputs.
 
 use bvh::scenes::random_molecule;
-use bvh::{Builder, Bvh, Geometry, LEAF_MAX};
+use bvh::{BuildOptions, Builder, Bvh, Geometry, LEAF_MAX};
 
 fn check(g: &Geometry) -> (Bvh, Bvh) {
     let b = Bvh::build(g);
@@ -35,6 +35,73 @@ fn binned_sah_close_to_full_sweep() {
         let nodes = b.nodes.len() * 32 + b.prim_ids.len() * 4;
         assert_eq!(st.node_bytes_per_atom(), per_atom(nodes));
         assert_eq!(st.bytes, records + nodes);
+    }
+}
+
+/// Issue #19: the clustered build (the default above [`bvh::CLUSTER_ABOVE`] primitives) within
+/// 10 % of the per-primitive binned build's SAH cost, which is within 8 % of the full sweep.
+#[test]
+fn clustered_sah_close_to_per_primitive() {
+    for (n, clustered, seed) in [(120_000, false, 4), (120_000, true, 5)] {
+        let g = random_molecule(n, clustered, seed);
+        assert!(g.prim_count() > bvh::CLUSTER_ABOVE);
+        let fast = Bvh::build(&g);
+        fast.validate(&g).unwrap();
+        let slow = Bvh::build_with(&g, &per_primitive());
+        slow.validate(&g).unwrap();
+        let ratio = fast.stats.sah_cost / slow.stats.sah_cost;
+        eprintln!(
+            "n={n} clustered={clustered}: clustered SAH {:.2}, per-primitive {:.2}, ratio {ratio:.4}",
+            fast.stats.sah_cost, slow.stats.sah_cost
+        );
+        assert!(ratio < 1.10, "clustered SAH {ratio} × per-primitive");
+        assert_ne!(fast.nodes, slow.nodes, "the two builders ran");
+    }
+}
+
+fn per_primitive() -> BuildOptions {
+    BuildOptions {
+        cluster_above: usize::MAX,
+        ..Default::default()
+    }
+}
+
+/// The clustered build on runs of one Morton code longer than a cluster (every atom in one
+/// place, or on one line), on a tiny scene (one cluster) and on NaN positions: a valid tree
+/// with the same closest hits as the per-primitive build.
+#[test]
+fn clustered_build_degenerate_runs() {
+    let forced = BuildOptions {
+        cluster_above: 0,
+        ..Default::default()
+    };
+    let line: Vec<f32> = (0..3000).map(|i| i as f32 * 1e-3).collect();
+    let cases: Vec<(Vec<f32>, Vec<f32>, Vec<f32>)> = vec![
+        (vec![1.0; 1000], vec![2.0; 1000], vec![3.0; 1000]),
+        (line.clone(), vec![0.0; 3000], vec![0.0; 3000]),
+        (vec![0.0, 1.0, 2.0], vec![0.0; 3], vec![0.0; 3]),
+        (
+            (0..700)
+                .map(|i| if i % 7 == 0 { f32::NAN } else { i as f32 })
+                .collect(),
+            vec![0.0; 700],
+            vec![0.0; 700],
+        ),
+    ];
+    for (x, y, z) in cases {
+        let n = x.len();
+        let bonds: Vec<[u32; 2]> = (1..n as u32).step_by(3).map(|i| [i - 1, i]).collect();
+        let g = Geometry::from_atoms(&x, &y, &z, &vec![0.4; n], &[], &bonds, 0.1);
+        let fast = Bvh::build_with(&g, &forced);
+        fast.validate(&g).unwrap();
+        let slow = Bvh::build_with(&g, &per_primitive());
+        slow.validate(&g).unwrap();
+        for k in 0..64 {
+            let a = k as f32 * 0.1;
+            let ray = bvh::Ray::new([a.sin() * 5.0, -20.0, a.cos() * 0.5], [0.0, 1.0, 0.0]);
+            let (h1, h2) = (fast.intersect_ray(&ray), slow.intersect_ray(&ray));
+            assert_eq!(h1.map(|h| h.t), h2.map(|h| h.t), "n={n} ray {k}");
+        }
     }
 }
 

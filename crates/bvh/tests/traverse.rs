@@ -52,10 +52,21 @@ fn rays(g: &Geometry, bvh: &Bvh, n: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
+/// Both builders (per primitive, and over Morton clusters as big scenes get by default), every
+/// backend: packets, single rays and the wide tree against brute force.
 fn compare(g: &Geometry, nrays: usize, seed: u64) {
-    let bvh = Bvh::build(g);
+    for cluster_above in [usize::MAX, 0] {
+        let opt = bvh::BuildOptions {
+            cluster_above,
+            ..Default::default()
+        };
+        compare_tree(g, &Bvh::build_with(g, &opt), nrays, seed);
+    }
+}
+
+fn compare_tree(g: &Geometry, bvh: &Bvh, nrays: usize, seed: u64) {
     bvh.validate(g).unwrap();
-    let rays = rays(g, &bvh, nrays, seed);
+    let rays = rays(g, bvh, nrays, seed);
     let reference = bvh.intersect_rays_brute(Isa::Scalar, &rays);
     let nhit = reference.iter().filter(|h| h.is_some()).count();
     assert!(nhit > nrays / 10, "test scene too sparse: {nhit} hits");
@@ -101,7 +112,7 @@ fn compare(g: &Geometry, nrays: usize, seed: u64) {
                 "single ray {i}"
             );
         }
-        check_wide(g, &bvh, &rays, &reference, isa);
+        check_wide(g, bvh, &rays, &reference, isa);
     }
 }
 

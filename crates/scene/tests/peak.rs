@@ -48,6 +48,27 @@ fn peak_of_spheres_by_hand() {
     assert_eq!(e.total(), live);
 }
 
+/// Spheres above `bvh::CLUSTER_ABOVE` primitives: the clustered build holds a second copy of
+/// the nodes and 4 B per primitive beside the model, more than the frame adds, so its phase
+/// is the peak; the same scene below the threshold peaks at the frame.
+#[test]
+fn peak_of_the_clustered_build_by_hand() {
+    let n_big = bvh::CLUSTER_ABOVE as u64 + 1000;
+    let m = generate(SceneName::Nanobowl, Some(n_big as usize), 1);
+    let n = m.len() as u64;
+    assert!(n > bvh::CLUSTER_ABOVE as u64, "{n} atoms");
+    let st = model_only(Style::Spheres, BondSource::None);
+    let e = MemoryEstimate::new(&m, 0, &st).unwrap();
+    let nodes = (n as f64 * BVH_NODES_PER_PRIM).ceil() as u64;
+    let rest = 13 * n + 8 * n + (20 * n + 8 * n) + (32 * nodes + 36 * n);
+    assert_eq!(e.peak.phase, PeakPhase::BvhBuild);
+    assert_eq!(e.peak.live, rest + 32 * nodes + 4 * n);
+    assert_eq!(e.total(), rest + 64 * 48 * 4);
+    let small = generate(SceneName::Nanobowl, Some(3000), 1);
+    let e = MemoryEstimate::new(&small, 0, &st).unwrap();
+    assert_eq!(e.peak.phase, PeakPhase::Frame);
+}
+
 /// The peak is above the scene at rest, and above what the built scene measures, for every
 /// kind of scene: dropping the peak term (or a phase of it) fails here.
 #[test]

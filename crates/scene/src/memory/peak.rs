@@ -8,11 +8,13 @@
 //! start. [`Peak::new`] sums what is alive in each phase, takes the largest and adds the
 //! baseline and the retention.
 //!
-//! The BVH build itself is no phase of its own: it writes each primitive record over the
-//! builder's reference to it (the same 32 B) and takes the model's scaled radii and colours
-//! over as the balls' arrays, so what is alive then is the scene at rest less the slot
-//! colours, ids and frame made after it. (Before, references and records were two arrays:
-//! 32 B per primitive more, the peak of every model.)
+//! The BVH build writes each primitive record over the builder's reference to it (the same
+//! 32 B) and takes the model's scaled radii and colours over as the balls' arrays, so what is
+//! alive then is the scene at rest less the slot colours, ids and frame made after it, plus,
+//! for the clustered build (more than `bvh::CLUSTER_ABOVE` primitives, at most
+//! `bvh::CLUSTER_UPTO`), a second copy of the nodes and 4 B per primitive for a moment
+//! ([`PeakPhase::BvhBuild`]). (Before, references and records were two arrays: 32 B per
+//! primitive more, the peak of every model.)
 //!
 //! Measured (BENCHMARKS.md, "Scale"): with `MALLOC_TRIM_THRESHOLD_=0` (glibc gives freed
 //! memory back at once) the live sum is the peak RSS within 2 %, 100 M-atom anp3 included
@@ -40,6 +42,10 @@ const BOND_BYTES: u64 = 8;
 pub enum PeakPhase {
     /// Bond search: molecule, cell grid, per-chunk bond lists and their concatenation.
     Bonds,
+    /// Clustered BVH build (`bvh::BuildOptions::cluster_above`): the model at rest plus a
+    /// second copy of the nodes (the clusters' subtrees while they are copied into the tree)
+    /// and their slots' primitive ids (4 B per primitive).
+    BvhBuild,
     /// 8-wide BVH build: the model at rest plus the wide nodes and the collapse's plan.
     WideBvh,
     /// Density build: the model at rest (if any), the per-slab atom lists, the per-thread
@@ -55,6 +61,7 @@ impl PeakPhase {
     pub fn name(self) -> &'static str {
         match self {
             PeakPhase::Bonds => "bonds",
+            PeakPhase::BvhBuild => "bvh build",
             PeakPhase::WideBvh => "wide bvh build",
             PeakPhase::Volume => "volume build",
             PeakPhase::Frame => "frame",
@@ -107,6 +114,11 @@ impl Peak {
             phases.push((PeakPhase::Bonds, e.atoms + grid + 2 * bond_list));
         }
         let model_rest = e.geometry + e.bvh;
+        let clustered = bvh::CLUSTER_ABOVE..=bvh::CLUSTER_UPTO;
+        if has_model && clustered.contains(&(c.prims as usize)) {
+            let build = e.atoms + bond_list + e.scratch + model_rest + c.nodes * 32 + c.prims * 4;
+            phases.push((PeakPhase::BvhBuild, build));
+        }
         if has_model && e.wide_bvh > 0 {
             let wide = e.atoms
                 + bond_list

@@ -16,7 +16,7 @@ pub const INNER: u32 = 0x8000_0000;
 ///
 /// (Tried: padding so every sibling pair fills one aligned 64-byte line. No measurable change,
 /// 8.8-9.1 vs 8.8-8.9 Mrays/s single-thread AVX-512 at 1024² on 1M primitives; not kept.)
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(32))]
 pub struct Node {
     /// Lower corner of the bounds (Å).

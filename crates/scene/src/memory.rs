@@ -112,9 +112,17 @@ impl MemoryEstimate {
             .is_some_and(|vs| vs.source == DensitySource::Particles)
         {
             // The BVH over the support spheres; while it is built, the geometry copy
-            // (20 B/atom), the support radii and the builder's 32-byte references.
-            e.volume = volume::Particles::estimate_bytes(m.len() as u64);
-            counts.density_scratch = m.len() as u64 * (20 + 4 + 32);
+            // (20 B/atom), the support radii and the builder's 32-byte references, and for
+            // the clustered build a second copy of the nodes and 4 B per sphere.
+            let n = m.len() as u64;
+            e.volume = volume::Particles::estimate_bytes(n);
+            let clustered = (bvh::CLUSTER_ABOVE..=bvh::CLUSTER_UPTO).contains(&m.len());
+            let second = if clustered {
+                (n as f64 * BVH_NODES_PER_PRIM).ceil() as u64 * NODE_BYTES + 4 * n
+            } else {
+                0
+            };
+            counts.density_scratch = n * (20 + 4 + 32) + second;
         } else if let Some(vs) = &settings.volume {
             let grid = density_grid(m, vs)?;
             counts.slab_entries = slab_entries(m, &grid);

@@ -94,22 +94,20 @@ fn bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
     (aabb(lo, hi), aabb(clo, chi))
 }
 
-/// The subtrees of a run of clusters (consecutive in the top tree's leaf order): their nodes
-/// one after another (each subtree's root first, children pairs adjacent, indices into this
-/// array, leaves holding global slots), where each subtree starts, and the primitive id of
-/// every slot.
+/// The subtrees of a run of consecutive clusters: their nodes one after another (each
+/// subtree's root first, children pairs adjacent, indices from the subtree's root, leaves
+/// holding global slots) and where each subtree starts (one more entry: the end).
 struct Group {
     nodes: Vec<Node>,
     roots: Vec<u32>,
-    ids: Vec<u32>,
 }
 
 /// Clusters per [`Group`].
 const GROUP: usize = 128;
 
-/// Builds the tree over `refs` (all primitives; `bounds`/`cb` their bounds and centroid
-/// bounds): returns the nodes (root at 0) and the primitive id of every leaf slot. `refs` is
-/// only read.
+/// Builds the tree over `refs` (all primitives; `cb` their centroid bounds): returns the
+/// nodes (root at 0) and the primitive id of every leaf slot. `refs` is only read. Slots are
+/// in Morton order: each cluster's leaves lie in the cluster's own run of it.
 pub(crate) fn build_clustered(
     refs: &[PrimRef],
     cb: &Aabb,
@@ -121,7 +119,9 @@ pub(crate) fn build_clustered(
     keys.par_sort_unstable();
     let mut runs = Vec::with_capacity(2 * refs.len() / CLUSTER_MAX + 1);
     cut(&keys, 0, keys.len(), 3 * MORTON_BITS, &mut runs);
-    let sorted: Vec<u32> = keys
+    // The references in Morton order; each cluster's build rewrites its run in leaf order,
+    // which makes this the slot order.
+    let mut order: Vec<u32> = keys
         .par_iter()
         .with_min_len(4096)
         .map(|&k| k as u32)
@@ -135,7 +135,7 @@ pub(crate) fn build_clustered(
         .with_min_len(256)
         .map(|(c, &(lo, hi))| {
             let mut b = Aabb::EMPTY;
-            for &i in &sorted[lo as usize..hi as usize] {
+            for &i in &order[lo as usize..hi as usize] {
                 b = b.union(refs[i as usize].aabb());
             }
             PrimRef::new(&b, c as u32)
@@ -158,67 +158,56 @@ pub(crate) fn build_clustered(
     );
     let top_nodes = assemble(sk);
 
-    // Slots: the clusters in the top tree's leaf order, each a contiguous range.
-    let mut first = Vec::with_capacity(crefs.len() + 1);
-    let mut acc = 0u32;
-    for r in &crefs {
-        first.push(acc);
-        let (lo, hi) = runs[r.id() as usize];
-        acc += hi - lo;
-    }
+    // The subtrees, GROUP clusters (one stretch of `order`) per task.
     let inner = Params {
         nb,
         leaf_max,
         small: super::SMALL_MAX,
     };
-    let groups: Vec<Group> = crefs
-        .par_chunks(GROUP)
-        .zip(first.par_chunks(GROUP))
-        .map(|(rs, bases)| {
+    let mut stretches = Vec::with_capacity(runs.len() / GROUP + 1);
+    let mut rest = &mut order[..];
+    for rs in runs.chunks(GROUP) {
+        let len = (rs[rs.len() - 1].1 - rs[0].0) as usize;
+        let (stretch, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        stretches.push((rs, stretch));
+        rest = tail;
+    }
+    let groups: Vec<Group> = stretches
+        .into_par_iter()
+        .map(|(rs, stretch)| {
             let mut g = Group {
                 nodes: Vec::with_capacity(rs.len() * CLUSTER_MAX / 2),
                 roots: Vec::with_capacity(rs.len() + 1),
-                ids: Vec::with_capacity(rs.len() * CLUSTER_MAX),
             };
             let mut local = Vec::with_capacity(CLUSTER_MAX);
-            for (r, &base) in rs.iter().zip(bases) {
-                let (lo, hi) = runs[r.id() as usize];
+            let at = rs[0].0;
+            for &(lo, hi) in rs {
+                let ids = &mut stretch[(lo - at) as usize..(hi - at) as usize];
                 local.clear();
-                local.extend(
-                    sorted[lo as usize..hi as usize]
-                        .iter()
-                        .map(|&i| refs[i as usize]),
-                );
+                local.extend(ids.iter().map(|&i| refs[i as usize]));
                 let (b, cb) = bounds(&local);
                 let root = g.nodes.len();
                 g.roots.push(root as u32);
                 g.nodes.push(Node::default());
-                build_seq(
-                    &mut local,
-                    base as usize,
-                    b,
-                    cb,
-                    inner,
-                    None,
-                    &mut g.nodes,
-                    root,
-                );
+                let (base, nodes) = (lo as usize, &mut g.nodes);
+                build_seq(&mut local, base, b, cb, inner, None, nodes, root);
                 // Inner nodes' child indices from the subtree's root, as `splice` reads them.
                 for m in &mut g.nodes[root..] {
                     if !m.is_leaf() {
                         m.first -= root as u32;
                     }
                 }
-                g.ids.extend(local.iter().map(|r| r.id()));
+                for (id, r) in ids.iter_mut().zip(&local) {
+                    *id = r.id();
+                }
             }
             g.roots.push(g.nodes.len() as u32);
-            done.fetch_add(g.ids.len() as u64, Ordering::Relaxed);
+            done.fetch_add(stretch.len() as u64, Ordering::Relaxed);
             g
         })
         .collect();
-    drop(sorted);
 
-    // Each cluster's subtree as a slice of its group's nodes, in the top tree's leaf order.
+    // Each cluster's subtree as a slice of its group's nodes, by cluster index.
     let subs: Vec<&[Node]> = groups
         .iter()
         .flat_map(|g| {
@@ -227,45 +216,53 @@ pub(crate) fn build_clustered(
                 .map(|w| &g.nodes[w[0] as usize..w[1] as usize])
         })
         .collect();
+    // The top tree's leaves hold slots of `crefs`; the subtree of each is its cluster's.
+    let top = Top {
+        nodes: &top_nodes,
+        subs: crefs.iter().map(|r| subs[r.id() as usize]).collect(),
+    };
     // Nodes below each top node once its leaves are replaced by the subtrees (for a leaf,
     // the subtree's nodes but its root), counted by a post-order walk.
     let mut below = vec![0usize; top_nodes.len()];
-    count_below(&top_nodes, 0, &subs, &mut below);
-    let mut out = vec![Node::default(); 1 + below[0]];
+    count_below(&top, 0, &mut below);
+    // (Filled in parallel: the pages are first touched on both threads. `zeroed_vec` is a
+    // one-thread `memset` for a 32-byte aligned type.)
+    let mut out: Vec<Node> = (0..1 + below[0])
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|_| Node::default())
+        .collect();
     let (root, rest) = out.split_first_mut().expect("one node at least");
-    splice(&top_nodes, 0, &subs, &below, root, rest, 1);
-    let order = groups.iter().flat_map(|g| g.ids.iter().copied()).collect();
+    splice(&top, 0, &below, root, rest, 1);
     (out, order)
 }
 
+/// The top tree over the clusters, and the subtree of each of its leaf slots.
+struct Top<'a> {
+    nodes: &'a [Node],
+    subs: Vec<&'a [Node]>,
+}
+
 /// Fills `below[t]` for the top subtree at `t`: the nodes under it in the final tree.
-fn count_below(top: &[Node], t: usize, subs: &[&[Node]], below: &mut [usize]) -> usize {
-    let n = top[t];
+fn count_below(top: &Top, t: usize, below: &mut [usize]) -> usize {
+    let n = top.nodes[t];
     let b = if n.is_leaf() {
-        subs[n.first as usize].len() - 1
+        top.subs[n.first as usize].len() - 1
     } else {
         let c = n.first as usize;
-        2 + count_below(top, c, subs, below) + count_below(top, c + 1, subs, below)
+        2 + count_below(top, c, below) + count_below(top, c + 1, below)
     };
     below[t] = b;
     b
 }
 
 /// Writes the top tree's node `t` into `slot` and the nodes under it into `rest` (which starts
-/// at index `base` of the final array), each top leaf (one cluster: slot = index into `subs`)
-/// replaced by that cluster's subtree; both halves in parallel when large.
-fn splice(
-    top: &[Node],
-    t: usize,
-    subs: &[&[Node]],
-    below: &[usize],
-    slot: &mut Node,
-    rest: &mut [Node],
-    base: usize,
-) {
-    let n = top[t];
+/// at index `base` of the final array), each top leaf replaced by its cluster's subtree; both
+/// halves in parallel when large.
+fn splice(top: &Top, t: usize, below: &[usize], slot: &mut Node, rest: &mut [Node], base: usize) {
+    let n = top.nodes[t];
     if n.is_leaf() {
-        let sub = subs[n.first as usize];
+        let sub = top.subs[n.first as usize];
         // The subtree's nodes are indexed from its root (local 0); local i >= 1 goes to
         // base + i - 1.
         let fix = |mut m: Node| {
@@ -289,11 +286,11 @@ fn splice(
     let (lbase, rbase) = (base + 2, base + 2 + below[c]);
     if below[t] > 1 << 14 {
         rayon::join(
-            || splice(top, c, subs, below, &mut l[0], lrest, lbase),
-            || splice(top, c + 1, subs, below, &mut r[0], rrest, rbase),
+            || splice(top, c, below, &mut l[0], lrest, lbase),
+            || splice(top, c + 1, below, &mut r[0], rrest, rbase),
         );
     } else {
-        splice(top, c, subs, below, &mut l[0], lrest, lbase);
-        splice(top, c + 1, subs, below, &mut r[0], rrest, rbase);
+        splice(top, c, below, &mut l[0], lrest, lbase);
+        splice(top, c + 1, below, &mut r[0], rrest, rbase);
     }
 }

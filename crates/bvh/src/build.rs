@@ -15,8 +15,8 @@ mod cluster;
 /// Most bins the binned builder supports.
 pub const MAX_BINS: usize = 32;
 /// Default of [`BuildOptions::cluster_above`]: below this the per-primitive build takes
-/// milliseconds, and a top tree over a few hundred clusters costs more SAH (+11 % at 6K
-/// primitives against +6 % at 1.5 M).
+/// milliseconds, and a top tree over a few dozen clusters costs more SAH (+2-3 % at 6-42K
+/// primitives against +1-2 % at 0.1-10 M).
 pub const CLUSTER_ABOVE: usize = 1 << 16;
 /// Default of [`BuildOptions::cluster_upto`]: 64 M primitives (a 32 M-atom b&s scene).
 pub const CLUSTER_UPTO: usize = 1 << 26;
@@ -30,7 +30,7 @@ const PAR_BIN: usize = 1 << 16;
 pub struct BuildOptions {
     /// Number of bins per axis (2..=[`MAX_BINS`]); small nodes use at most one bin per primitive.
     pub bins: usize,
-    /// Build over Morton-order clusters of primitives (1.5× faster, SAH ≈ +6 %) when there
+    /// Build over Morton-order clusters of primitives (1.4× faster, SAH +1-2 %) when there
     /// are more primitives than this and at most [`BuildOptions::cluster_upto`]; otherwise
     /// bin every primitive at every level (the reference the tests compare against).
     /// `usize::MAX`: never cluster.

@@ -1,11 +1,12 @@
 //! The clustered SAH build (issue #19): primitives sorted once by the Morton code of their
-//! centroids, cut into clusters of at most [`CLUSTER_MAX`] along that order (each a cell of
-//! the Morton grid), a binned SAH tree over the clusters' boxes, and inside each cluster an
-//! exact SAH sweep subtree. Every primitive is partitioned only within its cluster (≈ 5
-//! levels), not at every level of the tree (≈ 17 at 1.5 M primitives): the top levels bin one
-//! box per cluster instead of one per primitive. The price: splits between clusters lie on
-//! the Morton grid's planes (SAH ≈ +6 %), and the subtrees' nodes exist twice while they are
-//! copied into the tree (the per-primitive build frees its subtrees as it copies them).
+//! centroids and cut into clusters of at most [`CLUSTER_MAX`] along that order (each a cell
+//! of the Morton grid); a binned SAH tree over the clusters' boxes down to groups of at most
+//! [`TOP_LEAF`] clusters; below each group, the per-primitive binned SAH build over its
+//! primitives (exact sweeps from [`super::SMALL_MAX`] primitives down). The top ~10 levels
+//! bin one box per cluster instead of one per primitive, the bottom ones are the reference
+//! builder's own, so the tree is nearly as good (SAH +1-2 %) and no slower to trace. The
+//! price: the groups' nodes exist twice while they are copied into the tree (the
+//! per-primitive build frees its subtrees as it copies them).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -17,9 +18,13 @@ use crate::geometry::{Aabb, PrimRef};
 use crate::tree::Node;
 
 /// Most primitives in one cluster.
-/// (740K-atom `random_molecule`, 1.56 M primitives, 2 threads, Zen 3: 32 → SAH +9.6 % over
-/// the per-primitive build, 64 → +7.9 %, 128 → +6.5 %, at about the same speed.)
 pub(crate) const CLUSTER_MAX: usize = 128;
+/// Most clusters in a leaf of the top tree, i.e. under one per-primitive subtree. Measured
+/// (`bvh` example `build_time`, 740K / 4.8 M-atom `random_molecule`, 2 threads, Zen 3, AVX2
+/// camera rays, against the per-primitive build): 1 → 8.3 / 7.3 M prims/s, SAH +6.5 / +6.5 %,
+/// far rays +7 / +5 %; 8 → 7.0 / 6.5, +2.3 / +2.4 %, +1 / +4 %; 16 → 6.9 / 6.3, +1.5 /
+/// +1.9 %, ±0 / ±0 %; 32 → 6.6, +1.2 %, −1 %.
+const TOP_LEAF: usize = 16;
 /// Bits of the Morton code per axis.
 const MORTON_BITS: u32 = 10;
 
@@ -94,20 +99,9 @@ fn bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
     (aabb(lo, hi), aabb(clo, chi))
 }
 
-/// The subtrees of a run of consecutive clusters: their nodes one after another (each
-/// subtree's root first, children pairs adjacent, indices from the subtree's root, leaves
-/// holding global slots) and where each subtree starts (one more entry: the end).
-struct Group {
-    nodes: Vec<Node>,
-    roots: Vec<u32>,
-}
-
-/// Clusters per [`Group`].
-const GROUP: usize = 128;
-
 /// Builds the tree over `refs` (all primitives; `cb` their centroid bounds): returns the
-/// nodes (root at 0) and the primitive id of every leaf slot. `refs` is only read. Slots are
-/// in Morton order: each cluster's leaves lie in the cluster's own run of it.
+/// nodes (root at 0, children pairs adjacent) and the primitive id of every leaf slot. `refs`
+/// is only read.
 pub(crate) fn build_clustered(
     refs: &[PrimRef],
     cb: &Aabb,
@@ -119,9 +113,8 @@ pub(crate) fn build_clustered(
     keys.par_sort_unstable();
     let mut runs = Vec::with_capacity(2 * refs.len() / CLUSTER_MAX + 1);
     cut(&keys, 0, keys.len(), 3 * MORTON_BITS, &mut runs);
-    // The references in Morton order; each cluster's build rewrites its run in leaf order,
-    // which makes this the slot order.
-    let mut order: Vec<u32> = keys
+    // The references in Morton order: cluster c is `sorted[runs[c].0..runs[c].1]`.
+    let sorted: Vec<u32> = keys
         .par_iter()
         .with_min_len(4096)
         .map(|&k| k as u32)
@@ -135,7 +128,7 @@ pub(crate) fn build_clustered(
         .with_min_len(256)
         .map(|(c, &(lo, hi))| {
             let mut b = Aabb::EMPTY;
-            for &i in &order[lo as usize..hi as usize] {
+            for &i in &sorted[lo as usize..hi as usize] {
                 b = b.union(refs[i as usize].aabb());
             }
             PrimRef::new(&b, c as u32)
@@ -144,7 +137,7 @@ pub(crate) fn build_clustered(
     let (top_bounds, top_cb) = bounds(&crefs);
     let top = Params {
         nb,
-        leaf_max: 1,
+        leaf_max: TOP_LEAF,
         small: super::SMALL,
     };
     let sk = build_skeleton(
@@ -158,71 +151,64 @@ pub(crate) fn build_clustered(
     );
     let top_nodes = assemble(sk);
 
-    // The subtrees, GROUP clusters (one stretch of `order`) per task.
+    // The top tree's leaves (runs of `crefs`) in slot order, and the first slot of each.
+    let mut leaves: Vec<(usize, usize)> = top_nodes
+        .iter()
+        .filter(|n| n.is_leaf())
+        .map(|n| (n.first as usize, n.count()))
+        .collect();
+    leaves.sort_unstable();
+    let mut bases = Vec::with_capacity(leaves.len());
+    let mut acc = 0usize;
+    for &(f, c) in &leaves {
+        bases.push(acc);
+        for r in &crefs[f..f + c] {
+            let (lo, hi) = runs[r.id() as usize];
+            acc += (hi - lo) as usize;
+        }
+    }
     let inner = Params {
         nb,
         leaf_max,
         small: super::SMALL_MAX,
     };
-    let mut stretches = Vec::with_capacity(runs.len() / GROUP + 1);
-    let mut rest = &mut order[..];
-    for rs in runs.chunks(GROUP) {
-        let len = (rs[rs.len() - 1].1 - rs[0].0) as usize;
-        let (stretch, tail) = std::mem::take(&mut rest).split_at_mut(len);
-        stretches.push((rs, stretch));
-        rest = tail;
-    }
-    let groups: Vec<Group> = stretches
-        .into_par_iter()
-        .map(|(rs, stretch)| {
-            let mut g = Group {
-                nodes: Vec::with_capacity(rs.len() * CLUSTER_MAX / 2),
-                roots: Vec::with_capacity(rs.len() + 1),
-            };
-            let mut local = Vec::with_capacity(CLUSTER_MAX);
-            let at = rs[0].0;
-            for &(lo, hi) in rs {
-                let ids = &mut stretch[(lo - at) as usize..(hi - at) as usize];
-                local.clear();
-                local.extend(ids.iter().map(|&i| refs[i as usize]));
-                let (b, cb) = bounds(&local);
-                let root = g.nodes.len();
-                g.roots.push(root as u32);
-                g.nodes.push(Node::default());
-                let (base, nodes) = (lo as usize, &mut g.nodes);
-                build_seq(&mut local, base, b, cb, inner, None, nodes, root);
-                // Inner nodes' child indices from the subtree's root, as `splice` reads them.
-                for m in &mut g.nodes[root..] {
-                    if !m.is_leaf() {
-                        m.first -= root as u32;
-                    }
-                }
-                for (id, r) in ids.iter_mut().zip(&local) {
-                    *id = r.id();
-                }
+    // Each leaf's subtree (root at 0, leaves holding global slots) and the primitive of each
+    // of its slots.
+    let subs: Vec<(Vec<Node>, Vec<u32>)> = leaves
+        .par_iter()
+        .zip(bases.par_iter())
+        .map(|(&(f, c), &base)| {
+            let mut local: Vec<PrimRef> = Vec::new();
+            for r in &crefs[f..f + c] {
+                let (lo, hi) = runs[r.id() as usize];
+                local.extend(
+                    sorted[lo as usize..hi as usize]
+                        .iter()
+                        .map(|&i| refs[i as usize]),
+                );
             }
-            g.roots.push(g.nodes.len() as u32);
-            done.fetch_add(stretch.len() as u64, Ordering::Relaxed);
-            g
+            let (b, cb) = bounds(&local);
+            let mut nodes = Vec::with_capacity(local.len());
+            nodes.push(Node::default());
+            build_seq(&mut local, base, b, cb, inner, None, &mut nodes, 0);
+            done.fetch_add(local.len() as u64, Ordering::Relaxed);
+            (nodes, local.iter().map(|r| r.id()).collect())
         })
         .collect();
+    drop(sorted);
+    let (subs, ids): (Vec<Vec<Node>>, Vec<Vec<u32>>) = subs.into_iter().unzip();
+    let order = ids.concat();
+    drop(ids);
 
-    // Each cluster's subtree as a slice of its group's nodes, by cluster index.
-    let subs: Vec<&[Node]> = groups
-        .iter()
-        .flat_map(|g| {
-            g.roots
-                .windows(2)
-                .map(|w| &g.nodes[w[0] as usize..w[1] as usize])
-        })
-        .collect();
-    // The top tree's leaves hold slots of `crefs`; the subtree of each is its cluster's.
+    // A top leaf's `first` is its first slot of `crefs`; its subtree replaces it.
+    let mut by_slot: Vec<&[Node]> = vec![&[]; crefs.len()];
+    for (&(f, _), s) in leaves.iter().zip(&subs) {
+        by_slot[f] = s;
+    }
     let top = Top {
         nodes: &top_nodes,
-        subs: crefs.iter().map(|r| subs[r.id() as usize]).collect(),
+        subs: by_slot,
     };
-    // Nodes below each top node once its leaves are replaced by the subtrees (for a leaf,
-    // the subtree's nodes but its root), counted by a post-order walk.
     let mut below = vec![0usize; top_nodes.len()];
     count_below(&top, 0, &mut below);
     // (Filled in parallel: the pages are first touched on both threads. `zeroed_vec` is a
@@ -237,7 +223,8 @@ pub(crate) fn build_clustered(
     (out, order)
 }
 
-/// The top tree over the clusters, and the subtree of each of its leaf slots.
+/// The top tree over the clusters, and the subtree that replaces each of its leaves (by the
+/// leaf's first slot of the clusters' references).
 struct Top<'a> {
     nodes: &'a [Node],
     subs: Vec<&'a [Node]>,

@@ -4,31 +4,10 @@
 
 use std::hint::black_box;
 
-use bvh::scenes::{random_molecule, Rng};
+use bvh::scenes::{camera_rays, random_molecule, Rng};
 use bvh::{Bvh, Geometry, Ray, WideBvh};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use spmd::Isa;
-
-/// Primary rays of a `w × w` pinhole view of the whole scene, in 4×4 pixel blocks (so every
-/// backend's packets are neighbouring pixels).
-fn camera_rays(bvh: &Bvh, w: usize) -> Vec<Ray> {
-    let b = bvh.bounds;
-    let c = b.center();
-    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max);
-    let eye = [c[0], c[1], c[2] + 1.6 * ext];
-    let mut rays = Vec::with_capacity(w * w);
-    for by in (0..w).step_by(4) {
-        for bx in (0..w).step_by(4) {
-            for i in 0..16 {
-                let (x, y) = (bx + i % 4, by + i / 4);
-                let u = ((x as f32 + 0.5) / w as f32 - 0.5) * 0.8;
-                let v = (0.5 - (y as f32 + 0.5) / w as f32) * 0.8;
-                rays.push(Ray::new(eye, [u, v, -1.0]));
-            }
-        }
-    }
-    rays
-}
 
 fn ray_sphere(c: &mut Criterion) {
     // 64 spheres, 4096 rays: the kernel alone (brute force, no BVH).
@@ -61,7 +40,7 @@ fn ray_sphere(c: &mut Criterion) {
 fn packet_traversal(c: &mut Criterion) {
     let g = random_molecule(100_000, false, 7);
     let bvh = Bvh::build(&g);
-    let rays = camera_rays(&bvh, 256);
+    let rays = camera_rays(&bvh.bounds, 256, 1.0);
     let mut grp = c.benchmark_group("packet_traversal");
     grp.throughput(Throughput::Elements(rays.len() as u64));
     grp.sample_size(20);

@@ -4,28 +4,8 @@
 //! `cargo run --release -p bvh --example build_time -- [atoms] [reps] [both|clustered|reference]`.
 use std::time::Instant;
 
-use bvh::{Bvh, Ray};
-
-/// Primary rays of a `w × w` view of the whole scene down −z (zoomed by `zoom`), in 4×4
-/// pixel blocks as the renderer casts them.
-fn camera_rays(bvh: &Bvh, w: usize, zoom: f32) -> Vec<Ray> {
-    let b = bvh.bounds;
-    let c = b.center();
-    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max);
-    let eye = [c[0], c[1], c[2] + 1.6 * ext];
-    let mut rays = Vec::with_capacity(w * w);
-    for by in (0..w).step_by(4) {
-        for bx in (0..w).step_by(4) {
-            for i in 0..16 {
-                let (x, y) = (bx + i % 4, by + i / 4);
-                let u = ((x as f32 + 0.5) / w as f32 - 0.5) * 0.8 / zoom;
-                let v = (0.5 - (y as f32 + 0.5) / w as f32) * 0.8 / zoom;
-                rays.push(Ray::new(eye, [u, v, -1.0]));
-            }
-        }
-    }
-    rays
-}
+use bvh::scenes::camera_rays;
+use bvh::Bvh;
 
 /// Best of `reps` wall times (ms) of `f`.
 fn best_ms(reps: usize, mut f: impl FnMut()) -> f64 {
@@ -59,7 +39,10 @@ fn main() {
             b = Bvh::build_with(&g, &opt);
             best = best.min(b.stats.build_time.as_secs_f64());
         }
-        let (far, close) = (camera_rays(&b, 1024, 1.0), camera_rays(&b, 1024, 4.0));
+        let (far, close) = (
+            camera_rays(&b.bounds, 1024, 1.0),
+            camera_rays(&b.bounds, 1024, 4.0),
+        );
         let far_ms = best_ms(reps, || drop(b.intersect_rays(isa, &far)));
         let close_ms = best_ms(reps, || drop(b.intersect_rays(isa, &close)));
         println!(

@@ -1,7 +1,8 @@
 //! Small deterministic random scenes for tests and benchmarks (not the reference data sets,
 //! which live in the `molecule` crate).
 
-use crate::geometry::Geometry;
+use crate::geometry::{Aabb, Geometry};
+use crate::traverse::Ray;
 
 /// SplitMix64: tiny deterministic generator (tests and benches only).
 #[derive(Clone, Debug)]
@@ -84,4 +85,25 @@ pub fn random_molecule(n_atoms: usize, clustered: bool, seed: u64) -> Geometry {
         color.push(palette[e]);
     }
     Geometry::from_atoms(&x, &y, &z, &radius, &color, &bonds, 0.15)
+}
+
+/// Primary rays of a `w × w` pinhole view of the box `b` down −z, from 1.6 box extents above
+/// its centre (field of view ≈ 43.6°, narrowed by `zoom`), in 4×4 pixel blocks as the renderer
+/// casts them (so every backend's packets are neighbouring pixels). For benches and examples.
+pub fn camera_rays(b: &Aabb, w: usize, zoom: f32) -> Vec<Ray> {
+    let c = b.center();
+    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max);
+    let eye = [c[0], c[1], c[2] + 1.6 * ext];
+    let mut rays = Vec::with_capacity(w * w);
+    for by in (0..w).step_by(4) {
+        for bx in (0..w).step_by(4) {
+            for i in 0..16 {
+                let (x, y) = (bx + i % 4, by + i / 4);
+                let u = ((x as f32 + 0.5) / w as f32 - 0.5) * 0.8 / zoom;
+                let v = (0.5 - (y as f32 + 0.5) / w as f32) * 0.8 / zoom;
+                rays.push(Ray::new(eye, [u, v, -1.0]));
+            }
+        }
+    }
+    rays
 }

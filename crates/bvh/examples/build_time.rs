@@ -127,6 +127,18 @@ fn main() {
             per_eye.iter().sum::<f64>() / per_eye.len() as f64,
         );
         eyes.push(per_eye);
+        let t = Instant::now();
+        let c = bvh::compact::CompactBvh::new(&g, &b).expect("compact tree");
+        let collapse_ms = t.elapsed().as_secs_f64() * 1e3;
+        let far_c = best_ms(reps, || drop(c.intersect_rays(isa, &far)));
+        let close_c = best_ms(reps, || drop(c.intersect_rays(isa, &close)));
+        let inside_c = best_ms(reps, || drop(c.intersect_rays(isa, &inside)));
+        let atoms = g.balls.len() as f64;
+        println!(
+            "  compact: collapsed in {collapse_ms:.1} ms, {:.1} B/atom (tree {:.1}); rays far {far_c:.1} ms, zoom 4 {close_c:.1} ms, inside {inside_c:.1} ms",
+            c.bytes() as f64 / atoms,
+            b.stats.bytes as f64 / atoms,
+        );
     }
     if let [c, r] = &eyes[..] {
         let ratio: Vec<f64> = c.iter().zip(r).map(|(c, r)| c / r).collect();

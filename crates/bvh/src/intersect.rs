@@ -125,8 +125,20 @@ pub fn ray_cylinder<S: Simd>(
     let f = o - V3::splat(s, p0);
     let fa = f.dot(ax);
     let da = d.dot(ax);
-    let fp = f - ax.scale(fa);
-    let dp = d - ax.scale(da);
+    let (hit, tn, tf) = tube(s, f - ax.scale(fa), d - ax.scale(da), r);
+    let (zero, lenv) = (s.splat(0.0), s.splat(len));
+    let sn = fa + tn * da;
+    let sf = fa + tf * da;
+    let vn = hit & s.ge(sn, zero) & s.le(sn, lenv);
+    let vf = hit & s.ge(sf, zero) & s.le(sf, lenv);
+    pick(s, tn, vn, tf, vf, tmin, tmax)
+}
+
+/// Near and far roots of `|f⊥ + t·d⊥|² = r²` (a ray against an infinite cylinder, in the plane
+/// perpendicular to its axis) in [`ray_sphere`]'s stable form, and the lanes that have them
+/// (`d⊥ ≠ 0`, real roots).
+#[inline(always)]
+fn tube<S: Simd>(s: S, fp: V3<S>, dp: V3<S>, r: f32) -> (S::M, S::F32, S::F32) {
     let a = dp.dot(dp);
     let b = fp.dot(dp);
     let r2 = s.splat(r * r);
@@ -135,17 +147,88 @@ pub fn ray_cylinder<S: Simd>(
     let zero = s.splat(0.0);
     let hit = s.ge(disc, zero) & s.gt(a, zero);
     let q = -b - copysign(s, s.sqrt(s.max(a * disc, zero)), b);
-    let cc = fp.dot(fp) - r2;
-    let t0 = cc / q;
+    let t0 = (fp.dot(fp) - r2) / q;
     let t1 = q / a;
-    let tn = s.min(t0, t1);
-    let tf = s.max(t0, t1);
-    let lenv = s.splat(len);
-    let sn = fa + tn * da;
-    let sf = fa + tf * da;
-    let vn = hit & s.ge(sn, zero) & s.le(sn, lenv);
-    let vf = hit & s.ge(sf, zero) & s.le(sf, lenv);
+    (hit, s.min(t0, t1), s.max(t0, t1))
+}
+
+/// Ray–cylinder from `p` to `q` without a unit axis (§4.3, the compact layout's stick, issue
+/// #19): the axis is `e = q − p` and positions along it are fractions of `e`, so the only
+/// per-stick uniform work is `1/(e·e)` (no square root). Otherwise [`ray_cylinder`]'s stable
+/// form. Hits outside the segment are rejected; degenerate sticks (`e = 0`) and rays parallel
+/// to the axis miss.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn ray_bond<S: Simd>(
+    s: S,
+    o: V3<S>,
+    d: V3<S>,
+    p: [f32; 3],
+    e: [f32; 3],
+    r: f32,
+    tmin: S::F32,
+    tmax: S::F32,
+) -> (S::M, S::F32) {
+    let ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    let zero = s.splat(0.0);
+    if !(ee > 0.0 && ee.is_finite()) {
+        return (s.splat_m(false), zero);
+    }
+    let inv = s.splat(1.0 / ee);
+    let ev = V3::splat(s, e);
+    let f = o - V3::splat(s, p);
+    let fa = f.dot(ev) * inv;
+    let da = d.dot(ev) * inv;
+    let (hit, tn, tf) = tube(s, f - ev.scale(fa), d - ev.scale(da), r);
+    let one = s.splat(1.0);
+    let (un, uf) = (fa + tn * da, fa + tf * da);
+    let vn = hit & s.ge(un, zero) & s.le(un, one);
+    let vf = hit & s.ge(uf, zero) & s.le(uf, one);
     pick(s, tn, vn, tf, vf, tmin, tmax)
+}
+
+/// Leaf test of a stick from `p` to `q` for the compact layout: [`ray_bond`], and when
+/// `capped` the hemispherical caps of [`ray_cap`] (whole spheres for a degenerate stick);
+/// narrows `hit` as [`intersect_record`] does.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn intersect_bond<S: Simd>(
+    s: S,
+    ray: &RayPacket<S>,
+    m: S::M,
+    p: [f32; 3],
+    q: [f32; 3],
+    r: f32,
+    capped: bool,
+    slot: i32,
+    hit: &mut PacketHit<S>,
+) {
+    let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
+    let e = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+    let (h, th) = ray_bond(s, o, d, p, e, r, tmin, hit.t);
+    keep(s, h & m, th, slot, hit);
+    if capped {
+        for (c, side) in [(p, -1.0), (q, 1.0)] {
+            let (h, th) = ray_cap(s, o, d, c, e, side, r, tmin, hit.t);
+            keep(s, h & m, th, slot, hit);
+        }
+    }
+}
+
+/// Leaf test of a ball for the compact layout: [`ray_sphere`], narrowing `hit`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn intersect_ball<S: Simd>(
+    s: S,
+    ray: &RayPacket<S>,
+    m: S::M,
+    c: [f32; 3],
+    r: f32,
+    slot: i32,
+    hit: &mut PacketHit<S>,
+) {
+    let (h, th) = ray_sphere(s, ray.o, ray.d, c, r, ray.tmin, hit.t);
+    keep(s, h & m, th, slot, hit);
 }
 
 /// Leaf test (§4.3): intersects the lanes `m` of `ray` with one primitive record (sphere, open

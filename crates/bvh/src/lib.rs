@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 mod build;
+pub mod compact;
 mod geometry;
 mod intersect;
 mod query;
@@ -29,7 +30,8 @@ mod wide;
 pub use build::{BuildOptions, CLUSTER_ABOVE, CLUSTER_UPTO, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{
-    end_point, intersect_record, ray_cap, ray_cylinder, ray_sphere, surface, Surface,
+    end_point, intersect_ball, intersect_bond, intersect_record, ray_bond, ray_cap, ray_cylinder,
+    ray_sphere, surface, Surface,
 };
 pub use query::{Query, Stacks, Traversal};
 pub use spans::Span;

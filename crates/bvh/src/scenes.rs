@@ -107,3 +107,52 @@ pub fn camera_rays(b: &Aabb, w: usize, zoom: f32) -> Vec<Ray> {
     }
     rays
 }
+
+/// Test rays for the bounds `b` of `g`: from outside towards random points inside, one in
+/// five from near an atom (maybe inside its ball); every 11th with a shorter `tmax`, every
+/// 13th with `tmin = 1` Å.
+pub fn test_rays(g: &Geometry, b: &Aabb, n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    let c = b.center();
+    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max) as f64;
+    (0..n)
+        .map(|i| {
+            let target = [
+                rng.range(b.min[0] as f64, b.max[0] as f64),
+                rng.range(b.min[1] as f64, b.max[1] as f64),
+                rng.range(b.min[2] as f64, b.max[2] as f64),
+            ];
+            let o = if i % 5 == 0 {
+                // Inside the scene, maybe inside a ball.
+                let a = rng.below(g.balls.len());
+                [
+                    g.balls.x[a] as f64 + rng.range(-0.3, 0.3),
+                    g.balls.y[a] as f64,
+                    g.balls.z[a] as f64,
+                ]
+            } else {
+                let d = rng.dir();
+                [
+                    c[0] as f64 + d[0] * ext * 1.5,
+                    c[1] as f64 + d[1] * ext * 1.5,
+                    c[2] as f64 + d[2] * ext * 1.5,
+                ]
+            };
+            let mut r = Ray::new(
+                [o[0] as f32, o[1] as f32, o[2] as f32],
+                [
+                    (target[0] - o[0]) as f32,
+                    (target[1] - o[1]) as f32,
+                    (target[2] - o[2]) as f32,
+                ],
+            );
+            if i % 11 == 0 {
+                r.tmax = (ext * 0.7) as f32;
+            }
+            if i % 13 == 0 {
+                r.tmin = 1.0;
+            }
+            r
+        })
+        .collect()
+}

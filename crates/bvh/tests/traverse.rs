@@ -1,56 +1,8 @@
 //! Packet, single-ray and wide-BVH traversal against brute force, on every backend.
 
-use bvh::scenes::{random_molecule, Rng};
+use bvh::scenes::{random_molecule, test_rays};
 use bvh::{Bvh, Geometry, Ray, WideBvh};
 use spmd::Isa;
-
-/// Rays from outside the scene towards random points inside it, plus rays starting inside.
-fn rays(g: &Geometry, bvh: &Bvh, n: usize, seed: u64) -> Vec<Ray> {
-    let mut rng = Rng(seed);
-    let b = bvh.bounds;
-    let c = b.center();
-    let ext = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0f32, f32::max) as f64;
-    (0..n)
-        .map(|i| {
-            let target = [
-                rng.range(b.min[0] as f64, b.max[0] as f64),
-                rng.range(b.min[1] as f64, b.max[1] as f64),
-                rng.range(b.min[2] as f64, b.max[2] as f64),
-            ];
-            let o = if i % 5 == 0 {
-                // Inside the scene, maybe inside a ball.
-                let a = rng.below(g.balls.len());
-                [
-                    g.balls.x[a] as f64 + rng.range(-0.3, 0.3),
-                    g.balls.y[a] as f64,
-                    g.balls.z[a] as f64,
-                ]
-            } else {
-                let d = rng.dir();
-                [
-                    c[0] as f64 + d[0] * ext * 1.5,
-                    c[1] as f64 + d[1] * ext * 1.5,
-                    c[2] as f64 + d[2] * ext * 1.5,
-                ]
-            };
-            let mut r = Ray::new(
-                [o[0] as f32, o[1] as f32, o[2] as f32],
-                [
-                    (target[0] - o[0]) as f32,
-                    (target[1] - o[1]) as f32,
-                    (target[2] - o[2]) as f32,
-                ],
-            );
-            if i % 11 == 0 {
-                r.tmax = (ext * 0.7) as f32;
-            }
-            if i % 13 == 0 {
-                r.tmin = 1.0;
-            }
-            r
-        })
-        .collect()
-}
 
 /// Both builders (per primitive, and over Morton clusters as big scenes get by default), every
 /// backend: packets, single rays and the wide tree against brute force.
@@ -66,7 +18,7 @@ fn compare(g: &Geometry, nrays: usize, seed: u64) {
 
 fn compare_tree(g: &Geometry, bvh: &Bvh, nrays: usize, seed: u64) {
     bvh.validate(g).unwrap();
-    let rays = rays(g, bvh, nrays, seed);
+    let rays = test_rays(g, &bvh.bounds, nrays, seed);
     let reference = bvh.intersect_rays_brute(Isa::Scalar, &rays);
     let nhit = reference.iter().filter(|h| h.is_some()).count();
     assert!(nhit > nrays / 10, "test scene too sparse: {nhit} hits");
@@ -154,7 +106,7 @@ fn wide_tree_of_tiny_and_one_leaf_scenes() {
     for n in [1usize, 2, 5, 9, 40] {
         let g = random_molecule(n, true, 20 + n as u64);
         let bvh = Bvh::build(&g);
-        let rays = rays(&g, &bvh, 500, n as u64);
+        let rays = test_rays(&g, &bvh.bounds, 500, n as u64);
         let reference = bvh.intersect_rays_brute(Isa::Scalar, &rays);
         for isa in Isa::supported() {
             check_wide(&g, &bvh, &rays, &reference, isa);

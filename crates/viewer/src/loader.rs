@@ -162,15 +162,20 @@ impl Drop for Loader {
     }
 }
 
-/// Lowers the calling thread's scheduling priority to the lowest (nice 19), so that while the
-/// window renders, builds take only the CPU time the frames leave.
+/// Puts the calling thread at the lowest scheduling priority, so that while the window renders,
+/// builds take only the CPU time the frames leave: Linux's idle policy (`SCHED_IDLE`: a frame's
+/// thread that wakes takes the core back at once, not at the end of the build thread's time
+/// slice), and nice 19 where that policy is refused.
 fn yield_to_the_window() {
     #[cfg(target_os = "linux")]
-    // SAFETY: setpriority only reads its three integer arguments; on Linux `who` = 0 with
-    // PRIO_PROCESS names the calling thread, so only this thread's nice value changes. A
-    // failure (e.g. forbidden by a policy) leaves the priority as it was, which is harmless.
+    // SAFETY: setpriority only reads its three integer arguments and sched_setscheduler reads
+    // the `sched_param` that lives on this stack frame for the whole call; on Linux `who`/`pid`
+    // = 0 names the calling thread, so only this thread's priority changes. A failure (e.g.
+    // forbidden by a policy) leaves the priority as it was, which is harmless.
     unsafe {
         libc::setpriority(libc::PRIO_PROCESS, 0, 19);
+        let idle = libc::sched_param { sched_priority: 0 };
+        libc::sched_setscheduler(0, libc::SCHED_IDLE, &idle);
     }
 }
 

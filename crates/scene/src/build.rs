@@ -290,6 +290,9 @@ impl Scene {
             if ms.wide_bvh {
                 model.wide();
             }
+            if ms.compact_bvh {
+                model.compact();
+            }
             self.model = Some(model);
             self.timings.model = t.elapsed().as_secs_f64();
         }

@@ -14,6 +14,7 @@
 //! can only matter for a ray grazing a box face within `ε·|o|`; the tests (rays from
 //! surfaces included) find the same hits as brute force.
 
+mod collapse;
 mod qnode;
 
 use rayon::prelude::*;
@@ -111,23 +112,10 @@ impl CompactBvh {
         } else if top.is_leaf() {
             qnode::leaf_ref(&top)
         } else {
-            c.collapse(bvh, 0, 0)
+            (c.nodes, c.depth) = collapse::collapse(bvh, 0);
+            0
         };
         Ok(c)
-    }
-
-    /// Makes the node for binary inner node `i` and those below; returns its index.
-    fn collapse(&mut self, bvh: &Bvh, i: usize, depth: usize) -> u32 {
-        self.depth = self.depth.max(depth);
-        let (kids, n) = qnode::cut(bvh, i);
-        let at = self.nodes.len();
-        self.nodes.push(QNode::over(&bvh.nodes, &kids[..n]));
-        for (c, &k) in kids[..n].iter().enumerate() {
-            if !bvh.nodes[k].is_leaf() {
-                self.nodes[at].child[c] = self.collapse(bvh, k, depth + 1);
-            }
-        }
-        at as u32
     }
 
     /// Stack entries a query needs (a node pushes at most three).

@@ -116,7 +116,7 @@ pub struct LookArgs {
     pub bounce_traversal: SecondaryTraversal,
     /// The tree camera rays (and `--secondary packet` rays) traverse: the binary BVH, or the
     /// compact 4-wide tree with 8-bit child boxes (issue #19; made from the binary one after
-    /// the build and kept beside it, so it costs memory for now, about 55 B/atom).
+    /// the build and kept beside it, so for now it costs memory: 62 B/atom at ns740k).
     #[arg(help_heading = "Performance", long, value_enum, default_value_t = Tree::Binary)]
     pub tree: Tree,
     /// Volume: march every cell (no macrocell skipping), for comparison.

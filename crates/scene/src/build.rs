@@ -103,6 +103,8 @@ pub struct Timings {
     pub macrocells: f64,
     /// Light volume.
     pub light_volume: f64,
+    /// The compact tree collapsed from the BVH (part of `model`).
+    pub compact: f64,
 }
 
 /// Finest resolution (voxels per Å, i.e. steps of half of 1/this Å) of a grid-free volume.
@@ -291,7 +293,9 @@ impl Scene {
                 model.wide();
             }
             if ms.compact_bvh {
+                let tc = Instant::now();
                 model.compact();
+                self.timings.compact = tc.elapsed().as_secs_f64();
             }
             self.model = Some(model);
             self.timings.model = t.elapsed().as_secs_f64();

@@ -4,7 +4,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use render::{Camera, Look, Material, Mode, SecondaryTraversal, Tree};
+use render::{Camera, Look, Material, Mode, SecondaryTraversal};
 use scene::{CameraChoice, Orbit, ViewPreset};
 use volume::{Light, TransferFunction};
 
@@ -114,11 +114,6 @@ pub struct LookArgs {
     /// Traversal of the path tracer's bounced rays (camera rays always go in packets).
     #[arg(help_heading = "Path tracing", long, value_enum, default_value_t = SecondaryTraversal::Wide)]
     pub bounce_traversal: SecondaryTraversal,
-    /// The tree camera rays (and `--secondary packet` rays) traverse: the binary BVH, or the
-    /// compact 4-wide tree with 8-bit child boxes (issue #19; made from the binary one after
-    /// the build and kept beside it, so for now it costs memory: 62 B/atom at ns740k).
-    #[arg(help_heading = "Performance", long, value_enum, default_value_t = Tree::Binary)]
-    pub tree: Tree,
     /// Volume: march every cell (no macrocell skipping), for comparison.
     #[arg(help_heading = "Volume", long)]
     pub no_macrocells: bool,
@@ -195,7 +190,6 @@ impl LookArgs {
             sample_seed: self.sample_seed,
             secondary: self.secondary,
             bounces: self.bounce_traversal,
-            tree: self.tree,
             macrocells: !self.no_macrocells,
             preintegrated: !self.no_preintegration,
             memory_budget: self.memory_budget.map(|mb| mb.saturating_mul(1_000_000)),

@@ -89,7 +89,6 @@ impl GeometryArgs {
             stick_radius: self.stick_radius,
             color,
             wide_bvh: false,
-            compact_bvh: false,
             periodic_bonds: false,
             draw_cell: self.cell,
         })

@@ -1,10 +1,8 @@
-//! Ray queries by a chosen traversal: the packet traversal (§4.3) over the binary tree or over
-//! the compact 4-wide tree (issue #19), each lane alone on the scalar backend, or each lane
-//! alone through the 8-wide BVH — nearest hit or any hit.
+//! Secondary-ray queries by a chosen traversal: the packet traversal (§4.3), each lane alone on
+//! the scalar backend, or each lane alone through the 8-wide BVH — nearest hit or any hit.
 
 use spmd::{Scalar, Simd, V3};
 
-use crate::compact::CompactBvh;
 use crate::traverse::{PacketHit, Ray, RayPacket};
 use crate::tree::Bvh;
 use crate::wide::{WideBvh, WideEntry};
@@ -19,27 +17,22 @@ pub enum Traversal {
     Single,
     /// Each active lane alone through the 8-wide BVH.
     Wide,
-    /// The packet as one over the compact tree ([`CompactBvh`], collapsed from the binary
-    /// one with the same leaf slots, so hits name the same slots).
-    Compact,
 }
 
-/// Traversal stacks of one task: the binary BVH's (packets and single rays), the wide
-/// BVH's and the compact tree's (each empty when that tree is not given).
+/// Traversal stacks of one task: the binary BVH's (packets and single rays) and the wide
+/// BVH's (empty when no wide BVH is given).
 #[derive(Clone, Debug)]
 pub struct Stacks {
     packet: Vec<u32>,
     wide: Vec<WideEntry>,
-    compact: Vec<(u32, u32)>,
 }
 
 impl Stacks {
-    /// Stacks for queries of `bvh` and, when given, its wide and compact collapses.
-    pub fn new(bvh: &Bvh, wide: Option<&WideBvh>, compact: Option<&CompactBvh>) -> Stacks {
+    /// Stacks for queries of `bvh` and, when given, its wide BVH.
+    pub fn new(bvh: &Bvh, wide: Option<&WideBvh>) -> Stacks {
         Stacks {
             packet: vec![0; bvh.stack_size()],
             wide: wide.map_or(Vec::new(), |w| vec![WideEntry::default(); w.stack_size()]),
-            compact: compact.map_or(Vec::new(), |c| vec![(0, 0); c.stack_size()]),
         }
     }
 
@@ -50,16 +43,13 @@ impl Stacks {
 }
 
 /// The BVH and how to traverse it: `wide` must be `Some` (built from `bvh`) when `how` is
-/// [`Traversal::Wide`], `compact` when it is [`Traversal::Compact`] (else the binary tree's
-/// packet traversal is used).
+/// [`Traversal::Wide`].
 #[derive(Clone, Copy, Debug)]
 pub struct Query<'a> {
     /// The binary tree (its records are shared by the wide one).
     pub bvh: &'a Bvh,
     /// Its 8-wide collapse.
     pub wide: Option<&'a WideBvh>,
-    /// Its compact 4-wide collapse.
-    pub compact: Option<&'a CompactBvh>,
     /// The traversal.
     pub how: Traversal,
 }
@@ -68,12 +58,8 @@ impl Query<'_> {
     /// Lanes of `ray` (active ones) that hit anything in `(tmin, tmax)`.
     #[inline(always)]
     pub fn occluded<S: Simd>(&self, s: S, ray: &RayPacket<S>, st: &mut Stacks) -> S::M {
-        match (self.how, self.compact) {
-            (Traversal::Compact, Some(c)) => return c.occluded_packet(s, ray, &mut st.compact),
-            (Traversal::Packet | Traversal::Compact, _) => {
-                return self.bvh.occluded_packet(s, ray, &mut st.packet)
-            }
-            _ => {}
+        if self.how == Traversal::Packet {
+            return self.bvh.occluded_packet(s, ray, &mut st.packet);
         }
         let (_, slot) = self.lanes::<S, true>(s, ray, st);
         s.gt_i(s.load_i(&slot), s.splat_i(-1))
@@ -82,12 +68,8 @@ impl Query<'_> {
     /// Nearest hits of `ray` (as [`Bvh::traverse_packet`]: slot −1 where nothing is hit).
     #[inline(always)]
     pub fn closest<S: Simd>(&self, s: S, ray: &RayPacket<S>, st: &mut Stacks) -> PacketHit<S> {
-        match (self.how, self.compact) {
-            (Traversal::Compact, Some(c)) => return c.closest_packet(s, ray, &mut st.compact),
-            (Traversal::Packet | Traversal::Compact, _) => {
-                return self.bvh.traverse_packet(s, ray, &mut st.packet)
-            }
-            _ => {}
+        if self.how == Traversal::Packet {
+            return self.bvh.traverse_packet(s, ray, &mut st.packet);
         }
         let (t, slot) = self.lanes::<S, false>(s, ray, st);
         PacketHit {

@@ -6,7 +6,7 @@ use spmd::{Isa, Kernel, Simd, V3};
 
 use crate::integrator::{ao_factor, query, stacks};
 use crate::rng::Rng;
-use crate::settings::{RenderSettings, SecondaryTraversal};
+use crate::settings::SecondaryTraversal;
 
 /// Ambient occlusion at given surface points (Å) with outward unit normals: the fraction of
 /// `samples` cosine-distributed rays from each point (offset along its normal by `offset` Å)
@@ -50,9 +50,8 @@ impl Kernel for AoAtKernel<'_> {
     #[inline(always)]
     fn run<S: Simd>(self, s: S) -> Vec<f32> {
         let mut out = Vec::with_capacity(self.points.len());
-        let set = RenderSettings::default();
-        let mut stack = stacks(self.scene, &set);
-        let q = query(self.scene, SecondaryTraversal::Packet, &set);
+        let mut stack = stacks(self.scene, false);
+        let q = query(self.scene, SecondaryTraversal::Packet, false);
         let mut buf = [[0.0f32; spmd::MAX_LANES]; 6];
         let mut res = [0.0f32; spmd::MAX_LANES];
         for (c, (pts, nrm)) in self

@@ -261,12 +261,9 @@ fn drive<P: Send>(
     let start = Instant::now();
     let view = ViewRays::new(inp.camera, w, h);
     let across = w.div_ceil(TILE);
-    if let Some(m) = inp.model {
-        if set.uses_wide() {
+    if set.uses_wide() {
+        if let Some(m) = inp.model {
             m.wide();
-        }
-        if set.uses_compact() {
-            m.compact();
         }
     }
     let npx = AtomicU64::new(0);

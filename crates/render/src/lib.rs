@@ -41,7 +41,7 @@ pub use scene_image::{
     check_frame, draw_scene_legend, render_scene, render_scene_to_file, SceneFrame, SceneImage,
 };
 pub use settings::{
-    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, Tree, DARK_BACKGROUND,
+    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,
     DIRECT_AMBIENT, HEADLIGHT_AMBIENT, MAX_AO_SAMPLES, MAX_DEPTH, MAX_SPP, WHITE_BACKGROUND,
 };
 pub use streamed::{

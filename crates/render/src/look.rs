@@ -10,7 +10,7 @@ use scene::{
 use volume::{Light, Lighting, MarchOptions, VolumeShadows};
 
 use crate::settings::{
-    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, Tree, DARK_BACKGROUND,
+    Material, Modality, RenderSettings, SecondaryTraversal, SettingsError, DARK_BACKGROUND,
     DIRECT_AMBIENT, HEADLIGHT_AMBIENT, WHITE_BACKGROUND,
 };
 
@@ -105,8 +105,6 @@ pub struct Look {
     pub secondary: SecondaryTraversal,
     /// Traversal of the path tracer's bounced rays.
     pub bounces: SecondaryTraversal,
-    /// The tree of packet traversals (camera rays, `Packet` secondary rays).
-    pub tree: Tree,
     /// Volume: skip empty macrocells.
     pub macrocells: bool,
     /// Volume: pre-integrated classification (else post-classification).
@@ -144,7 +142,6 @@ impl Default for Look {
             sample_seed: r.seed,
             secondary: r.secondary,
             bounces: r.bounces,
-            tree: r.tree,
             macrocells: true,
             preintegrated: true,
             memory_budget: None,
@@ -238,7 +235,6 @@ impl Look {
             shadow_step_voxels: self.shadow_step,
             secondary: self.secondary,
             bounces: self.bounces,
-            tree: self.tree,
             packet_registers: 0,
         }
     }
@@ -261,7 +257,6 @@ impl Look {
         SceneSettings {
             model: self.mode.has_model().then(|| ModelSettings {
                 wide_bvh: render.uses_wide(),
-                compact_bvh: render.uses_compact(),
                 ..self.model.clone()
             }),
             bonds,

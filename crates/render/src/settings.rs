@@ -106,22 +106,6 @@ impl From<SecondaryTraversal> for bvh::Traversal {
     }
 }
 
-/// Which tree packets of rays traverse: camera rays always, shadow and AO rays when their
-/// traversal is [`SecondaryTraversal::Packet`]. Both give the same hits (the compact tree is
-/// collapsed from the binary one and keeps its leaf slots); sticks are tested without a unit
-/// axis in the compact tree, so a stick's `t` can differ in the last bits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-pub enum Tree {
-    /// The binary BVH with its 32-byte primitive records (paper §4.3).
-    #[default]
-    Binary,
-    /// The compact 4-wide tree with 8-bit child boxes (`Model::compact`, issue #19), made
-    /// from the binary one before the first frame. Today it is kept beside the binary tree,
-    /// whose records still shade the hits, so it adds memory rather than saving it.
-    Compact,
-}
-
 /// Every option of a frame (one typed struct for all modalities; check it with
 /// [`RenderSettings::validate`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,8 +141,6 @@ pub struct RenderSettings {
     pub secondary: SecondaryTraversal,
     /// Traversal of the path tracer's bounced rays (primary rays always go in packets).
     pub bounces: SecondaryTraversal,
-    /// The tree of packet traversals (camera rays, `Packet` secondary rays).
-    pub tree: Tree,
     /// Headlight: SIMD registers per primary ray packet (1, 2 or 4; 0 = the measured default
     /// per ISA).
     pub packet_registers: usize,
@@ -181,7 +163,6 @@ impl Default for RenderSettings {
             shadow_step_voxels: 2.0,
             secondary: SecondaryTraversal::Packet,
             bounces: SecondaryTraversal::Wide,
-            tree: Tree::Binary,
             packet_registers: 0,
         }
     }
@@ -295,11 +276,6 @@ impl RenderSettings {
             Modality::Ao { .. } => self.secondary == wide,
             Modality::Path { .. } => self.bounces == wide || self.secondary == wide,
         }
-    }
-
-    /// Whether these settings use the compact tree (so it is made before the tiles start).
-    pub fn uses_compact(&self) -> bool {
-        self.tree == Tree::Compact
     }
 
     /// Background as packed RGBA8 (alpha 255).

@@ -103,8 +103,6 @@ pub struct Timings {
     pub macrocells: f64,
     /// Light volume.
     pub light_volume: f64,
-    /// The compact tree collapsed from the BVH (part of `model`).
-    pub compact: f64,
 }
 
 /// Finest resolution (voxels per Å, i.e. steps of half of 1/this Å) of a grid-free volume.
@@ -291,11 +289,6 @@ impl Scene {
             let model = build_model(m, &self.bonds, ms, &mut self.scratch, &progress.done)?;
             if ms.wide_bvh {
                 model.wide();
-            }
-            if ms.compact_bvh {
-                let tc = Instant::now();
-                model.compact();
-                self.timings.compact = tc.elapsed().as_secs_f64();
             }
             self.model = Some(model);
             self.timings.model = t.elapsed().as_secs_f64();

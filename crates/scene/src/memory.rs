@@ -24,9 +24,6 @@ pub const BVH_NODES_PER_PRIM: f64 = 0.70;
 /// collapse before it: 0.097, 0.122, 0.124, 0.085, 0.148, its half-empty bottom nodes
 /// depending on the depth of the binary tree.)
 pub const WIDE_NODES_PER_PRIM: f64 = 0.062;
-/// Compact 4-wide nodes per primitive (`bvh::compact`, collapsed from the binary tree):
-/// measured 0.166 (nanobowl), 0.171 (ns90k), 0.171 (sio2 at 200 K atoms).
-pub const COMPACT_NODES_PER_PRIM: f64 = 0.17;
 /// Bytes per pixel of the frame `render` draws: the packed RGBA8 framebuffer (the tile
 /// driver keeps its sums per tile; the f32 `render::Accum` of progressive front ends, 12 B
 /// more per pixel, is not counted). Measured: `render 2r9r-1b.xyz` (1,284 atoms) peaks 12.6 MB
@@ -36,8 +33,6 @@ pub const FRAME_BYTES_PER_PIXEL: u64 = 4;
 const NODE_BYTES: u64 = 32;
 /// Bytes of an 8-wide node.
 const WIDE_NODE_BYTES: u64 = 256;
-/// Bytes of a compact node.
-const COMPACT_NODE_BYTES: u64 = 64;
 /// Bytes per primitive slot in the BVH: id (4) + intersection record (32).
 const SLOT_BYTES: u64 = 36;
 
@@ -57,9 +52,6 @@ pub struct MemoryEstimate {
     pub bvh: u64,
     /// 8-wide BVH (256 B/node), when the settings use it.
     pub wide_bvh: u64,
-    /// Compact tree (64 B/node, 4 B/slot) with its own points (16 B/atom) and bond pairs
-    /// (8 B/stick), when the settings use it.
-    pub compact_bvh: u64,
     /// Density voxels.
     pub volume: u64,
     /// Macrocell min/max pairs (8 B/cell).
@@ -112,13 +104,6 @@ impl MemoryEstimate {
             e.bvh = nodes * NODE_BYTES + prims as u64 * SLOT_BYTES;
             if ms.wide_bvh {
                 e.wide_bvh = (prims as f64 * WIDE_NODES_PER_PRIM).ceil() as u64 * WIDE_NODE_BYTES;
-            }
-            if ms.compact_bvh {
-                let nodes = (prims as f64 * COMPACT_NODES_PER_PRIM).ceil() as u64;
-                e.compact_bvh = nodes * COMPACT_NODE_BYTES
-                    + prims as u64 * 4
-                    + m.len() as u64 * 16
-                    + bonds as u64 * 8;
             }
         }
         if settings
@@ -179,9 +164,6 @@ impl MemoryEstimate {
             if scene.settings.model.as_ref().is_some_and(|s| s.wide_bvh) {
                 e.wide_bvh = md.wide().bytes() as u64;
             }
-            if scene.settings.model.as_ref().is_some_and(|s| s.compact_bvh) {
-                e.compact_bvh = md.compact().map_or(0, |c| c.bytes() as u64);
-            }
         }
         match scene.volume.as_ref().map(|d| &d.density) {
             Some(Density::Grid { volume, cells }) => {
@@ -217,14 +199,13 @@ impl MemoryEstimate {
     }
 
     /// `(name, bytes)` of every component, in a fixed order.
-    pub fn components(&self) -> [(&'static str, u64); 11] {
+    pub fn components(&self) -> [(&'static str, u64); 10] {
         [
             ("atoms", self.atoms),
             ("bonds", self.bonds),
             ("geometry", self.geometry),
             ("bvh", self.bvh),
             ("wide_bvh", self.wide_bvh),
-            ("compact_bvh", self.compact_bvh),
             ("volume", self.volume),
             ("macrocells", self.macrocells),
             ("light_volume", self.light_volume),

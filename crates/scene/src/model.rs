@@ -3,7 +3,6 @@
 use std::sync::atomic::AtomicU64;
 use std::sync::OnceLock;
 
-use bvh::compact::CompactBvh;
 use bvh::{Balls, BuildOptions, Bvh, Geometry, Prim, WideBvh};
 use rayon::prelude::*;
 
@@ -98,9 +97,6 @@ pub struct Model {
     pub color_range: Option<(f32, f32)>,
     /// The 8-wide BVH for single incoherent rays, collapsed from `bvh` on first use.
     wide: OnceLock<WideBvh>,
-    /// The compact 4-wide tree, collapsed from `bvh` on first use (`None`: too many
-    /// primitives for its leaf references).
-    compact: OnceLock<Option<CompactBvh>>,
 }
 
 impl Model {
@@ -258,7 +254,6 @@ impl Model {
             radius,
             color_range: None,
             wide: OnceLock::new(),
-            compact: OnceLock::new(),
         }
     }
 
@@ -266,14 +261,5 @@ impl Model {
     /// `bvh` the first time it is asked for (a few ms per million primitives).
     pub fn wide(&self) -> &WideBvh {
         self.wide.get_or_init(|| WideBvh::new(&self.bvh))
-    }
-
-    /// The compact tree of packet rays (`render::Tree::Compact`), collapsed from `bvh` the
-    /// first time it is asked for (tens of ms per million primitives); `None` above
-    /// [`bvh::compact::MAX_SLOTS`] primitives, where the binary tree serves instead.
-    pub fn compact(&self) -> Option<&CompactBvh> {
-        self.compact
-            .get_or_init(|| CompactBvh::new(&self.geometry, &self.bvh).ok())
-            .as_ref()
     }
 }

@@ -4,7 +4,7 @@ use crate::build::Scene;
 use crate::Density;
 
 impl Scene {
-    /// One line per built stage (`unwrap:`, `bonds:`, `bvh:`, `compact:`, `volume:`, `light:`): wall time (s), size
+    /// One line per built stage (`unwrap:`, `bonds:`, `bvh:`, `volume:`, `light:`): wall time (s), size
     /// and the figures a user checks first (BVH nodes and SAH cost, lattice points, MB). The
     /// `bvh:` line gives bytes per atom in all (the kernels' primitive records + nodes and ids), then
     /// each part, and the build rate in million primitives per second.
@@ -34,18 +34,6 @@ impl Scene {
                 st.prims_per_second() * 1e-6,
                 t.model
             ));
-            let want_compact = self.settings.model.as_ref().is_some_and(|m| m.compact_bvh);
-            if let Some(c) = model.compact().filter(|_| want_compact) {
-                let atoms = model.geometry.balls.len().max(1) as f64;
-                out.push(format!(
-                    "compact: {:.3} s  {} nodes (depth {}), {:.1} MB ({:.1} B/atom) beside the bvh",
-                    t.compact,
-                    c.nodes.len(),
-                    c.depth,
-                    c.bytes() as f64 / 1e6,
-                    c.bytes() as f64 / atoms
-                ));
-            }
         }
         if let (Some(d), Some(vs)) = (&self.volume, &self.settings.volume) {
             out.push(match &d.density {

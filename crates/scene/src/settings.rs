@@ -52,9 +52,6 @@ pub struct ModelSettings {
     /// The 8-wide BVH will be used (secondary or bounce rays `Wide`): counted by
     /// [`crate::MemoryEstimate`] and built by [`crate::Scene::build`].
     pub wide_bvh: bool,
-    /// The compact 4-wide tree will be used (`render::Tree::Compact`): counted by
-    /// [`crate::MemoryEstimate`] and made by [`crate::Scene::build`].
-    pub compact_bvh: bool,
     /// Draw a bond that crosses the periodic boundary of the input's cell as two half-sticks
     /// at the two sides of the cell (the CLI's `--pbc`); off, or without a cell, a bond is
     /// drawn between the two atoms as they are.
@@ -73,7 +70,6 @@ impl Default for ModelSettings {
             stick_radius: 0.15,
             color: ColorBy::Element,
             wide_bvh: false,
-            compact_bvh: false,
             periodic_bonds: false,
             draw_cell: false,
         }

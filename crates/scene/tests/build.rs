@@ -15,7 +15,6 @@ fn settings(wide: bool, volume: bool) -> SceneSettings {
     SceneSettings {
         model: Some(ModelSettings {
             wide_bvh: wide,
-            compact_bvh: wide,
             ..ModelSettings::default()
         }),
         volume: volume.then(|| common::lit_volume(VolumeFormat::U8)),
@@ -38,15 +37,12 @@ fn check_estimate(name: SceneName, atoms: Option<usize>, volume: bool) {
     let real = MemoryEstimate::measured(&s, &m);
     let md = s.model.as_ref().unwrap();
     eprintln!(
-        "{name}: prims {} nodes {} ({:.4}/prim) wide {} ({:.4}/prim) compact {} ({:.4}/prim); \
-         est {est:?} real {real:?}",
+        "{name}: prims {} nodes {} ({:.4}/prim) wide {} ({:.4}/prim); est {est:?} real {real:?}",
         md.bvh.stats.prims,
         md.bvh.stats.nodes,
         md.bvh.stats.nodes as f64 / md.bvh.stats.prims as f64,
         md.wide().nodes.len(),
-        md.wide().nodes.len() as f64 / md.bvh.stats.prims as f64,
-        md.compact().unwrap().nodes.len(),
-        md.compact().unwrap().nodes.len() as f64 / md.bvh.stats.prims as f64
+        md.wide().nodes.len() as f64 / md.bvh.stats.prims as f64
     );
     // Exact where the sizes are known up front.
     for (a, b) in est.components().iter().zip(real.components()) {
@@ -54,8 +50,6 @@ fn check_estimate(name: SceneName, atoms: Option<usize>, volume: bool) {
             "bvh" => assert!(rel(a.1, b.1) < 0.10, "{name} bvh: {} vs {}", a.1, b.1),
             // One constant for the wide node count: 0.057-0.068 nodes per primitive measured.
             "wide_bvh" => assert!(rel(a.1, b.1) < 0.10, "{name} wide: {} vs {}", a.1, b.1),
-            // One constant for the compact node count: 0.166-0.171 nodes per primitive.
-            "compact_bvh" => assert!(rel(a.1, b.1) < 0.10, "{name} compact: {} vs {}", a.1, b.1),
             _ => assert_eq!(a.1, b.1, "{name} {}", a.0),
         }
     }

@@ -693,7 +693,6 @@ fn fit(scene: &Scene, need: &SceneSettings) -> Fit {
         (Some(n), Some(h)) => {
             scene::ModelSettings {
                 wide_bvh: h.wide_bvh,
-                compact_bvh: h.compact_bvh,
                 ..n.clone()
             } == *h
         }

@@ -5,7 +5,7 @@ use bvh::{Query, RayPacket, Stacks};
 use scene::Model;
 use spmd::{Simd, V3};
 
-use super::{over_rgb, spawn, trace_by, Queries, TileJob};
+use super::{over_rgb, spawn, trace, TileJob};
 use crate::rng::{cosine_dir, Rng};
 use crate::settings::Modality;
 
@@ -15,7 +15,7 @@ pub(super) fn sample<S: Simd>(
     s: S,
     k: &TileJob<'_>,
     model: &Model,
-    qs: &Queries,
+    q: &Query,
     ray: &RayPacket<S>,
     rng: &mut Rng<S>,
     st: &mut Stacks,
@@ -25,21 +25,11 @@ pub(super) fn sample<S: Simd>(
     };
     let opt = k.set;
     let bg = V3::splat(s, opt.background_unit());
-    let tr = trace_by(s, model, k.volume, &qs.camera, ray, st);
+    let tr = trace(s, Some(model), k.volume, ray, st.packet());
     let mut c = bg;
     if s.any(tr.mask) {
         let o = spawn(s, model, &tr);
-        let ao = ao_factor(
-            s,
-            &qs.secondary,
-            o,
-            tr.n,
-            tr.mask,
-            samples,
-            distance,
-            rng,
-            st,
-        );
+        let ao = ao_factor(s, q, o, tr.n, tr.mask, samples, distance, rng, st);
         c = V3::select(s, tr.mask, tr.color.scale(ao), bg);
     }
     over_rgb(s, tr.volume, c)

@@ -5,7 +5,7 @@ use bvh::{Query, RayPacket, Stacks};
 use scene::Model;
 use spmd::{Simd, V3};
 
-use super::{over_rgb, spawn, trace_by, Queries, TileJob};
+use super::{over_rgb, spawn, trace, TileJob};
 use crate::settings::Modality;
 
 /// One Direct sample of a packet of camera rays.
@@ -14,7 +14,7 @@ pub(super) fn sample<S: Simd>(
     s: S,
     k: &TileJob<'_>,
     model: &Model,
-    qs: &Queries,
+    q: &Query,
     ray: &RayPacket<S>,
     st: &mut Stacks,
 ) -> V3<S> {
@@ -23,7 +23,7 @@ pub(super) fn sample<S: Simd>(
     let bg = V3::splat(s, opt.background_unit());
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
-    let tr = trace_by(s, model, k.volume, &qs.camera, ray, st);
+    let tr = trace(s, Some(model), k.volume, ray, st.packet());
     let mut c = bg;
     if s.any(tr.mask) {
         let o = spawn(s, model, &tr);
@@ -32,7 +32,7 @@ pub(super) fn sample<S: Simd>(
         let lit = tr.mask & s.gt(ndl, zero);
         let mut vis = s.select(lit, one, zero);
         if shadows && s.any(lit) {
-            vis = visibility(s, k, &qs.secondary, o, l, dist, lit, st);
+            vis = visibility(s, k, q, o, l, dist, lit, st);
         }
         let shade = s.splat(opt.ambient) + s.splat(opt.light_intensity) * ndl * vis;
         c = V3::select(s, tr.mask, tr.color.scale(shade), bg);

@@ -2,11 +2,11 @@
 //! `N` registers of camera rays per packet, headlight diffuse shading, the volume composited
 //! in front of the opaque hit. Packed RGBA8 output.
 
-use bvh::{surface, PacketHit, Query, RayPacket, Stacks, Traversal};
+use bvh::{surface, RayPacket};
 use scene::Model;
 use spmd::{Simd, V3};
 
-use super::{stacks, Queries, TileJob, TILE_PIXELS};
+use super::{TileJob, TILE_PIXELS};
 use crate::camera_rays::block_width;
 use crate::TILE;
 
@@ -44,13 +44,7 @@ pub(super) fn tile<S: Simd>(s: S, k: &TileJob<'_>) -> Vec<u32> {
 #[inline(always)]
 fn render_tile<S: Simd, const N: usize>(s: S, k: &TileJob<'_>, out: &mut [u32]) {
     let v = k.view;
-    let (mut st, cam) = match k.model {
-        Some(sc) => (
-            Some(stacks(sc, k.set)),
-            Some(Queries::new(sc, k.set).camera),
-        ),
-        None => (None, None),
-    };
+    let mut stack = vec![0u32; k.model.map_or(0, |sc| sc.bvh.stack_size())];
     // One register covers bw × bh pixels; N registers a gw × gh grid of those.
     let bw = block_width(S::LANES);
     let bh = S::LANES / bw;
@@ -96,9 +90,10 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &TileJob<'_>, out: &mut [u32]) 
             }
             // Pass 1 (§4.2): opaque geometry, shaded; the hit depth bounds the volume pass.
             // (No closure here: closures do not inherit the entry point's target features.)
-            let hits = match (&cam, &mut st) {
-                (Some(q), Some(st)) => Some(camera_hits::<S, N>(s, q, &rays, st)),
-                _ => None,
+            #[allow(clippy::manual_map)]
+            let hits = match k.model {
+                Some(sc) => Some(sc.bvh.traverse_packets::<S, N>(s, &rays, &mut stack)),
+                None => None,
             };
             for j in 0..N {
                 let ray = &rays[j];
@@ -123,28 +118,6 @@ fn render_tile<S: Simd, const N: usize>(s: S, k: &TileJob<'_>, out: &mut [u32]) 
             }
         }
     }
-}
-
-/// Nearest hits of `N` registers of camera rays by `q`: one packet of `N` registers over the
-/// binary tree, each register alone over the compact tree.
-#[inline(always)]
-fn camera_hits<S: Simd, const N: usize>(
-    s: S,
-    q: &Query,
-    rays: &[RayPacket<S>; N],
-    st: &mut Stacks,
-) -> [PacketHit<S>; N] {
-    if q.how != Traversal::Compact {
-        return q.bvh.traverse_packets::<S, N>(s, rays, st.packet());
-    }
-    let mut hits = [PacketHit {
-        t: s.splat(0.0),
-        slot: s.splat_i(-1),
-    }; N];
-    for (h, ray) in hits.iter_mut().zip(rays) {
-        *h = q.closest(s, ray, st);
-    }
-    hits
 }
 
 /// Headlight-shaded colour of the b&s hits of one packet (background where missed) and the

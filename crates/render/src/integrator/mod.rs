@@ -21,7 +21,7 @@ use spmd::{Kernel, Simd, V3};
 use volume::Medium;
 
 use crate::camera_rays::ViewRays;
-use crate::settings::{Modality, RenderSettings, Tree};
+use crate::settings::{Modality, RenderSettings};
 use crate::TILE;
 
 /// A tile's result: packed RGBA8 (headlight modes) or per-pixel RGB sums of `spp` samples
@@ -83,57 +83,21 @@ impl Kernel for SampledTile<'_> {
     }
 }
 
-/// The query of `model` by `how` for settings `set`: `Packet` goes over `set.tree`; the
-/// wide and compact trees are looked up once.
+/// The secondary-ray query of `model` by `how` (the wide BVH looked up once; `wide`: the
+/// settings use it, see [`crate::RenderSettings::uses_wide`]).
 #[inline(always)]
-pub(crate) fn query<'a>(
-    model: &'a Model,
-    how: crate::SecondaryTraversal,
-    set: &RenderSettings,
-) -> Query<'a> {
-    let how = match (how, set.tree) {
-        (crate::SecondaryTraversal::Packet, Tree::Compact) => bvh::Traversal::Compact,
-        (how, _) => how.into(),
-    };
+pub(crate) fn query(model: &Model, how: crate::SecondaryTraversal, wide: bool) -> Query<'_> {
+    let how: bvh::Traversal = how.into();
     Query {
         bvh: &model.bvh,
-        wide: (set.uses_wide() && how == bvh::Traversal::Wide).then(|| model.wide()),
-        compact: (how == bvh::Traversal::Compact)
-            .then(|| model.compact())
-            .flatten(),
+        wide: (wide && how == bvh::Traversal::Wide).then(|| model.wide()),
         how,
     }
 }
 
-/// The queries of a tile's rays.
-pub(crate) struct Queries<'a> {
-    /// Camera rays: packets over `set.tree`.
-    pub(crate) camera: Query<'a>,
-    /// Shadow and AO rays, the path tracer's light samples (`set.secondary`).
-    pub(crate) secondary: Query<'a>,
-    /// The path tracer's bounced rays (`set.bounces`).
-    pub(crate) bounce: Query<'a>,
-}
-
-impl<'a> Queries<'a> {
-    /// The queries `set` asks for over `model`.
-    #[inline(always)]
-    pub(crate) fn new(model: &'a Model, set: &RenderSettings) -> Queries<'a> {
-        Queries {
-            camera: query(model, crate::SecondaryTraversal::Packet, set),
-            secondary: query(model, set.secondary, set),
-            bounce: query(model, set.bounces, set),
-        }
-    }
-}
-
-/// Traversal stacks for the trees `set` uses over `model`.
-pub(crate) fn stacks(model: &Model, set: &RenderSettings) -> Stacks {
-    Stacks::new(
-        &model.bvh,
-        set.uses_wide().then(|| model.wide()),
-        set.uses_compact().then(|| model.compact()).flatten(),
-    )
+/// Traversal stacks for `model`'s binary BVH and, when `wide`, its wide BVH.
+pub(crate) fn stacks(model: &Model, wide: bool) -> Stacks {
+    Stacks::new(&model.bvh, wide.then(|| model.wide()))
 }
 
 /// What [`trace`] found for a packet.
@@ -164,40 +128,27 @@ pub fn trace<S: Simd>(
     ray: &RayPacket<S>,
     stack: &mut [u32],
 ) -> Traced<S> {
-    let out = match model {
+    let mut out = match model {
         Some(sc) => hit_surface(s, sc, ray, sc.bvh.traverse_packet(s, ray, stack)),
         None => traced_none(s),
     };
-    with_volume(s, out, volume, ray)
-}
-
-/// [`trace`] with the opaque pass by the query `q` (the renderer's camera rays).
-#[inline(always)]
-pub(crate) fn trace_by<S: Simd>(
-    s: S,
-    model: &Model,
-    volume: Option<&Medium>,
-    q: &Query,
-    ray: &RayPacket<S>,
-    st: &mut Stacks,
-) -> Traced<S> {
-    let out = hit_surface(s, model, ray, q.closest(s, ray, st));
-    with_volume(s, out, volume, ray)
-}
-
-/// `out` with the volume pass (when `volume` is given) marched up to its opaque hit.
-#[inline(always)]
-fn with_volume<S: Simd>(
-    s: S,
-    mut out: Traced<S>,
-    volume: Option<&Medium>,
-    ray: &RayPacket<S>,
-) -> Traced<S> {
     if let Some(vs) = volume {
         let depth = s.select(out.mask, out.hit.t, s.splat(f32::INFINITY));
         out.volume = vs.march(s, ray.o, ray.d, depth, ray.active);
     }
     out
+}
+
+/// [`trace`]'s opaque pass for secondary rays by the query `q` (no volume pass).
+#[inline(always)]
+pub(crate) fn trace_secondary<S: Simd>(
+    s: S,
+    model: &Model,
+    q: &Query,
+    ray: &RayPacket<S>,
+    st: &mut Stacks,
+) -> Traced<S> {
+    hit_surface(s, model, ray, q.closest(s, ray, st))
 }
 
 /// A [`Traced`] with no hit and no volume.

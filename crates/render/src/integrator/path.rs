@@ -1,23 +1,25 @@
 //! Path-tracing integrator: progressive, linear radiance; metal (Schlick Fresnel, blurred
 //! mirror) or diffuse BRDF with next-event estimation of the light; environment = background.
 
-use bvh::{RayPacket, Stacks};
+use bvh::{Query, RayPacket, Stacks};
 use scene::Model;
 use spmd::{Simd, V3};
 
 use super::direct::visibility;
-use super::{spawn, trace_by, Queries, TileJob};
+use super::{spawn, trace, trace_secondary, TileJob};
 use crate::rng::{cosine_dir, unit_vector, Rng};
 use crate::settings::{Material, Modality};
 
-/// One path of a packet of camera rays (`qs.bounce`: the query of bounced rays,
-/// `qs.secondary`: of light samples).
+/// One path of a packet of camera rays (`bounce`: the query of bounced rays, `q`: of light
+/// samples).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn sample<S: Simd>(
     s: S,
     k: &TileJob<'_>,
     model: &Model,
-    qs: &Queries,
+    bounce: &Query,
+    q: &Query,
     ray: &RayPacket<S>,
     rng: &mut Rng<S>,
     st: &mut Stacks,
@@ -40,8 +42,11 @@ pub(super) fn sample<S: Simd>(
     let mut r = *ray;
     for depth in 0..max_depth.max(1) {
         // Camera rays are coherent (packets); bounced rays use `opt.bounces`.
-        let q = if depth == 0 { &qs.camera } else { &qs.bounce };
-        let tr = trace_by(s, model, None, q, &r, st);
+        let tr = if depth == 0 {
+            trace(s, Some(model), None, &r, st.packet())
+        } else {
+            trace_secondary(s, model, bounce, &r, st)
+        };
         let miss = r.active & !tr.mask;
         radiance = V3::select(s, miss, radiance + tp * env, radiance);
         let alive = tr.mask;
@@ -60,7 +65,7 @@ pub(super) fn sample<S: Simd>(
                     let ndl = s.max(n.dot(l), zero);
                     let lit = alive & s.gt(ndl, zero);
                     if s.any(lit) {
-                        let vis = visibility(s, k, &qs.secondary, o, l, dist, lit, st);
+                        let vis = visibility(s, k, q, o, l, dist, lit, st);
                         let e = s.splat(opt.light_intensity) * ndl * vis;
                         radiance = V3::select(s, lit, radiance + (tp * albedo).scale(e), radiance);
                     }

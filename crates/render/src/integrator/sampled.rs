@@ -4,7 +4,7 @@
 
 use spmd::{Simd, V3};
 
-use super::{ao, direct, path, stacks, Queries, TileJob, TILE_PIXELS};
+use super::{ao, direct, path, query, stacks, TileJob, TILE_PIXELS};
 use crate::camera_rays::block_width;
 use crate::rng::Rng;
 use crate::settings::Modality;
@@ -17,8 +17,10 @@ pub(super) fn tile<S: Simd>(s: S, k: &TileJob<'_>) -> Vec<f32> {
         .model
         .expect("validated: ray-traced modalities have a model");
     let v = k.view;
-    let mut stack = stacks(model, k.set);
-    let qs = Queries::new(model, k.set);
+    let mut stack = stacks(model, k.set.uses_wide());
+    let wide = k.set.uses_wide();
+    let sec = query(model, k.set.secondary, wide);
+    let bounce = query(model, k.set.bounces, wide);
     let bw = block_width(S::LANES);
     let bh = S::LANES / bw;
     let mut lx = [0.0f32; spmd::MAX_LANES];
@@ -54,10 +56,12 @@ pub(super) fn tile<S: Simd>(s: S, k: &TileJob<'_>) -> Vec<f32> {
                 let ray = v.rays(s, px0 + jx, py0 + jy, active);
                 let c = match k.set.modality {
                     Modality::Path { .. } => {
-                        path::sample(s, k, model, &qs, &ray, &mut rng, &mut stack)
+                        path::sample(s, k, model, &bounce, &sec, &ray, &mut rng, &mut stack)
                     }
-                    Modality::Ao { .. } => ao::sample(s, k, model, &qs, &ray, &mut rng, &mut stack),
-                    _ => direct::sample(s, k, model, &qs, &ray, &mut stack),
+                    Modality::Ao { .. } => {
+                        ao::sample(s, k, model, &sec, &ray, &mut rng, &mut stack)
+                    }
+                    _ => direct::sample(s, k, model, &sec, &ray, &mut stack),
                 };
                 sum = sum + c;
             }

@@ -48,8 +48,6 @@ pub enum PeakPhase {
     BvhBuild,
     /// 8-wide BVH build: the model at rest plus the wide nodes and the collapse's plan.
     WideBvh,
-    /// Compact tree: the model at rest plus the compact tree and the slack of its node list.
-    CompactBvh,
     /// Density build: the model at rest (if any), the per-slab atom lists, the per-thread
     /// block scratch and the voxels.
     Volume,
@@ -65,7 +63,6 @@ impl PeakPhase {
             PeakPhase::Bonds => "bonds",
             PeakPhase::BvhBuild => "bvh build",
             PeakPhase::WideBvh => "wide bvh build",
-            PeakPhase::CompactBvh => "compact bvh build",
             PeakPhase::Volume => "volume build",
             PeakPhase::Frame => "frame",
         }
@@ -131,24 +128,12 @@ impl Peak {
                 + c.nodes * WIDE_PLAN_BYTES_PER_NODE;
             phases.push((PeakPhase::WideBvh, wide));
         }
-        // The compact tree's node list grows by doubling: up to twice its nodes while made.
-        if has_model && e.compact_bvh > 0 {
-            let compact = e.atoms
-                + bond_list
-                + e.scratch
-                + model_rest
-                + e.wide_bvh
-                + e.compact_bvh
-                + (c.prims as f64 * super::COMPACT_NODES_PER_PRIM) as u64 * 64;
-            phases.push((PeakPhase::CompactBvh, compact));
-        }
         if e.volume > 0 {
             let volume = e.atoms
                 + bond_list
                 + e.scratch
                 + model_rest
                 + e.wide_bvh
-                + e.compact_bvh
                 + 4 * c.slab_entries
                 + c.density_scratch
                 + e.volume;

@@ -1,33 +1,11 @@
 //! The parallel collapse (`CompactBvh::new`, `compact/collapse.rs`) against one thread's
-//! depth-first recursion kept here (the one `CompactBvh::new` used before): the same node
-//! array bit for bit, the same root, depth and slot ids, on scenes deep enough that the
-//! subtrees below the threaded levels are written too.
+//! depth-first recursion kept here (the one `CompactBvh::new` used before, over the same
+//! `compact::cut`): the same node array bit for bit, the same root, depth and slot ids, on
+//! scenes deep enough that the subtrees below the threaded levels are written too.
 
-use bvh::compact::{CompactBvh, QNode, EMPTY};
+use bvh::compact::{cut, CompactBvh, QNode, EMPTY};
 use bvh::scenes::random_molecule;
 use bvh::{BuildOptions, Bvh, Geometry};
-
-/// The binary nodes under inner node `i` that become one 4-wide node: its two children,
-/// then the inner child of largest area opened until four (as `compact::qnode::cut`).
-fn cut(b: &Bvh, i: usize) -> ([usize; 4], usize) {
-    let first = b.nodes[i].first as usize;
-    let mut kids = [first, first + 1, 0, 0];
-    let mut n = 2;
-    while n < 4 {
-        let open = (0..n)
-            .filter(|&c| !b.nodes[kids[c]].is_leaf())
-            .max_by(|&x, &y| {
-                let area = |c: usize| b.nodes[kids[c]].aabb().area();
-                area(x).total_cmp(&area(y))
-            });
-        let Some(c) = open else { break };
-        let f = b.nodes[kids[c]].first as usize;
-        kids[c] = f;
-        kids[n] = f + 1;
-        n += 1;
-    }
-    (kids, n)
-}
 
 /// One thread's collapse: the node for binary inner node `i`, then the subtree of each inner
 /// child in child order; returns the node's index.

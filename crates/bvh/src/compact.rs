@@ -25,7 +25,6 @@ use crate::intersect::{intersect_ball, intersect_bond};
 use crate::traverse::{load_packet, PacketHit, Ray, RayPacket, BOX_GROW};
 use crate::tree::Bvh;
 /// Which binary nodes become one 4-wide node (for tests that rebuild the tree another way).
-#[cfg(any(test, feature = "testing"))]
 pub use qnode::cut;
 pub use qnode::{QNode, EMPTY, LEAF, MAX_SLOTS};
 

@@ -20,7 +20,6 @@ pub mod compact;
 mod geometry;
 mod intersect;
 mod query;
-#[cfg(any(test, feature = "testing"))]
 pub mod scenes;
 mod spans;
 mod traverse;

@@ -17,10 +17,10 @@ pub struct GeometryArgs {
     /// Radius used for the balls.
     #[arg(long, value_enum, default_value_t = RadiusKind::Covalent)]
     pub radius: RadiusKind,
-    /// Ball radius = element radius × this.
+    /// Ball radius = element radius × this (above 0, up to 1000).
     #[arg(long, default_value_t = 0.5)]
     pub radius_scale: f32,
-    /// Stick radius (Å).
+    /// Stick radius (Å, above 0, up to 1000).
     #[arg(long, default_value_t = 0.15)]
     pub stick_radius: f32,
     /// Colour atoms by `element` (CPK/Jmol colours) or by a per-atom column of the input

@@ -106,7 +106,7 @@ impl FromStr for SceneName {
 /// result is within ~1% of the request for requests of a few thousand atoms or more, and
 /// identical for identical `(name, atoms, seed)`.
 pub fn generate(name: SceneName, atoms: Option<usize>, seed: u64) -> Molecule {
-    let n = atoms.unwrap_or(name.default_atoms()).max(1);
+    let n = atoms.unwrap_or(name.default_atoms());
     match name {
         SceneName::Nanobowl => nanobowl(n),
         SceneName::Ns90k | SceneName::Ns740k => onion(n, seed),
@@ -126,6 +126,9 @@ pub const BYTES_PER_ATOM: u64 = 64;
 /// Why [`try_generate`] refused.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// Zero atoms asked for.
+    #[error("0 atoms asked for; ask for at least 1 with --atoms")]
+    NoAtoms,
     /// More atoms than [`MAX_ATOMS`].
     #[error("{atoms} atoms is more than the limit of {max} (2^31); ask for fewer with --atoms")]
     TooManyAtoms {
@@ -159,9 +162,12 @@ pub fn available_memory() -> Option<u64> {
     kb.checked_mul(1024)
 }
 
-/// Check a requested atom count against [`MAX_ATOMS`] and `available` memory (bytes; `None`
+/// Check a requested atom count (at least 1) against [`MAX_ATOMS`] and `available` memory (bytes; `None`
 /// = unknown, not checked) before anything is allocated.
 pub fn check_atoms(atoms: usize, available: Option<u64>) -> Result<(), SceneError> {
+    if atoms == 0 {
+        return Err(SceneError::NoAtoms);
+    }
     if atoms > MAX_ATOMS {
         return Err(SceneError::TooManyAtoms {
             atoms,
@@ -186,7 +192,7 @@ pub fn try_generate(
     atoms: Option<usize>,
     seed: u64,
 ) -> Result<Molecule, SceneError> {
-    let n = atoms.unwrap_or(name.default_atoms()).max(1);
+    let n = atoms.unwrap_or(name.default_atoms());
     check_atoms(n, available_memory())?;
     Ok(generate(name, Some(n), seed))
 }

@@ -199,6 +199,13 @@ fn absurd_atom_counts() {
     assert!(matches!(e, SceneError::OutOfMemory { .. }));
     assert!(e.to_string().contains("--atoms"));
     assert!(check_atoms(1000, Some(1 << 30)).is_ok());
+    // Zero is refused, not quietly made one atom.
+    assert!(matches!(check_atoms(0, None), Err(SceneError::NoAtoms)));
+    assert!(matches!(
+        molecule::scenes::try_generate(molecule::scenes::SceneName::Anp3, Some(0), 1),
+        Err(SceneError::NoAtoms)
+    ));
+    assert!(check_atoms(1, None).is_ok());
 }
 
 /// Item 8: huge cutoffs are refused from the grid estimate, before collecting bonds.

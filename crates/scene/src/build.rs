@@ -438,19 +438,24 @@ impl Scene {
     }
 }
 
+/// Largest `radius-scale` and `stick-radius` (Å) accepted: a ball or stick 1000 Å across
+/// (2000 Å for the largest element radii) is no molecule, and radii near 1e19 overflow the
+/// boxes' squared extents and areas (SAH NaN, an empty picture) instead of failing.
+const MAX_RADIUS: f32 = 1000.0;
+
 /// Rejects out-of-range model settings.
 fn check_model(ms: &ModelSettings) -> Result<(), SceneError> {
-    if !(ms.radius_scale > 0.0 && ms.radius_scale.is_finite()) {
+    if !(ms.radius_scale > 0.0 && ms.radius_scale <= MAX_RADIUS) {
         return Err(SceneError::BadSetting {
             name: "radius-scale",
-            expected: "a positive number",
+            expected: "a positive number up to 1000",
             value: ms.radius_scale,
         });
     }
-    if !(ms.stick_radius > 0.0 && ms.stick_radius.is_finite()) {
+    if !(ms.stick_radius > 0.0 && ms.stick_radius <= MAX_RADIUS) {
         return Err(SceneError::BadSetting {
             name: "stick-radius",
-            expected: "a positive number of Å",
+            expected: "a positive number of Å up to 1000",
             value: ms.stick_radius,
         });
     }

@@ -162,6 +162,26 @@ fn bad_settings_are_errors() {
             ..
         })
     ));
+    // Radii so large that the boxes' areas overflow (SAH NaN, an empty picture), NaN, and
+    // just past the limit are errors; the limit itself is not.
+    for (scale, stick, bad) in [
+        (1e30, 0.15, Some("radius-scale")),
+        (f32::NAN, 0.15, Some("radius-scale")),
+        (1000.5, 0.15, Some("radius-scale")),
+        (0.5, 1e30, Some("stick-radius")),
+        (0.5, f32::INFINITY, Some("stick-radius")),
+        (0.5, -0.15, Some("stick-radius")),
+        (1000.0, 1000.0, None),
+    ] {
+        let mut st = settings(false, false);
+        let ms = st.model.as_mut().unwrap();
+        (ms.radius_scale, ms.stick_radius) = (scale, stick);
+        match (Scene::build(Isa::Scalar, &m, &st), bad) {
+            (Err(SceneError::BadSetting { name, .. }), Some(want)) => assert_eq!(name, want),
+            (Ok(_), None) => {}
+            (r, _) => panic!("radius-scale {scale}, stick-radius {stick}: {:?}", r.err()),
+        }
+    }
     let mut st = settings(false, false);
     st.model.as_mut().unwrap().color = ColorBy::Column {
         name: "nope".into(),

@@ -260,6 +260,8 @@ fn march_impl<S: Simd, V: Voxels>(
     let ambient = s.splat(opts.ambient);
     let cutoff = s.splat(opts.opacity_cutoff);
     let preint = opts.preintegrated;
+    // Lanes whose opacity reached the cut-off (composited no more; retired one iteration late).
+    let mut opaque = s.splat_m(false);
     loop {
         // Phase 1: lanes that need a cell walk the DDA until a non-empty one (or the end).
         while use_cells && s.any(need) {
@@ -350,16 +352,21 @@ fn march_impl<S: Simd, V: Voxels>(
             }
         }
         let w = (one - acc[3]) * frac;
+        let composited = valid & !opaque;
         for (a, ch) in acc.iter_mut().zip(c) {
-            *a = s.select(valid, *a + w * ch, *a);
+            *a = s.select(composited, *a + w * ch, *a);
         }
         s_prev = s.select(valid, sb, s_prev);
         k = s.select(valid, k + one, k);
         prev_k = s.select(valid, k, prev_k);
-        let opaque = valid & s.ge(acc[3], cutoff);
+        // Early termination one iteration late: lanes that passed the cut-off last time stop
+        // now, and those passing it now fetch once more without compositing. So the next
+        // iteration's gather masks do not wait on this one's table gather (a loop-carried
+        // chain through two dependent gathers; the same pictures, 1.1-1.25× on ns740k).
         alive = alive & !opaque;
         marching = marching & !opaque;
         need = need & !opaque;
+        opaque = opaque | (valid & s.ge(acc[3], cutoff));
     }
     acc
 }

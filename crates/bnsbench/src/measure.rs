@@ -9,7 +9,9 @@ use molecule::scenes::{try_generate, SceneName};
 use render::{render_frame, Camera, FrameInputs, Framebuffer, RenderSettings, View};
 use scene::{ball_sphere, BondSettings, Model, Sphere, VolumeSettings, LIGHT_VOLUME_STRIDE};
 use spmd::Isa;
-use volume::{ClassifiedTf, LightVolume, MarchOptions, Medium, VolumeFormat, VolumeScene};
+use volume::{
+    ClassifiedTf, EmptySpace, LightVolume, MarchOptions, Medium, VolumeFormat, VolumeScene,
+};
 
 use crate::error::BenchError;
 use crate::mode::BenchMode;
@@ -163,7 +165,8 @@ impl Session<'_> {
                 mb(v.bytes())
             );
             let ctf = ClassifiedTf::new(&cfg.tf, 0.0, v.max_value, settings.step_voxels);
-            Some((v, cells, secs, ctf))
+            let empty = EmptySpace::build(&cells, &ctf);
+            Some((v, cells, secs, ctf, empty))
         } else {
             None
         };
@@ -178,7 +181,9 @@ impl Session<'_> {
             volume_s: vol.as_ref().map(|v| v.2),
             geometry_bytes: sizes.map(|s| s.0),
             bvh_bytes: sizes.map(|s| s.1),
-            volume_bytes: vol.as_ref().map(|v| v.0.bytes() + v.1.bytes()),
+            volume_bytes: vol
+                .as_ref()
+                .map(|v| v.0.bytes() + v.1.bytes() + v.4.bytes()),
             voxels_per_angstrom: vpa,
             volume_dims: vol.as_ref().map(|v| v.0.grid.dims),
             peak_rss_mb: peak_rss_mb(),
@@ -187,12 +192,12 @@ impl Session<'_> {
 
         // The marcher's view of the volume with a mode's options.
         let vscene = |mode: BenchMode| -> Option<VolumeScene<'_>> {
-            let (v, cells, _, ctf) = vol.as_ref().filter(|_| mode.volume())?;
+            let (v, cells, _, ctf, empty) = vol.as_ref().filter(|_| mode.volume())?;
             let opts = MarchOptions {
                 macrocells: !cfg.no_macrocells,
                 ..mode.settings().march
             };
-            Some(VolumeScene::new(v, cells, ctf, opts))
+            Some(VolumeScene::new(v, cells, ctf, opts).with_empty_space(empty))
         };
         // Every mode of a scene sees the same frame: the ball-and-stick sphere.
         let sphere = match &model {

@@ -11,8 +11,9 @@ use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
-    build_density, density_work, ClassifiedTf, DensityParams, Grid, LightVolume, Macrocells,
-    MarchOptions, Medium, ParticleScene, Particles, TransferFunction, Volume, VolumeScene,
+    build_density, density_work, ClassifiedTf, DensityParams, EmptySpace, Grid, LightVolume,
+    Macrocells, MarchOptions, Medium, ParticleScene, Particles, TransferFunction, Volume,
+    VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -158,6 +159,19 @@ pub struct DensityVolume {
     /// The density at the top of the transfer function: `VolumeSettings::density_max`, or
     /// the volume's maximum.
     pub tf_max: f32,
+    /// Distances to the nearest macrocell `tf` does not make empty (grids only), rebuilt
+    /// with `tf`.
+    pub empty: Option<EmptySpace>,
+}
+
+impl DensityVolume {
+    /// The empty-space map of `density` under `tf` (`None` for grid-free volumes).
+    fn empty_space(density: &Density, tf: &ClassifiedTf) -> Option<EmptySpace> {
+        match density {
+            Density::Grid { cells, .. } => Some(EmptySpace::build(cells, tf)),
+            Density::Particles(_) => None,
+        }
+    }
 }
 
 /// Everything the renderer traces for one frame of a molecule.
@@ -363,12 +377,14 @@ impl Scene {
             let t = Instant::now();
             let tf_max = tf_max.unwrap_or(density.max_value());
             let tf = ClassifiedTf::new(&vs.tf, 0.0, tf_max, vs.step_voxels);
+            let empty = DensityVolume::empty_space(&density, &tf);
             self.timings.macrocells += t.elapsed().as_secs_f64();
             progress.done.store(1, Ordering::Relaxed);
             let d = DensityVolume {
                 density,
                 tf,
                 tf_max,
+                empty,
             };
             if let (Some(lv), Density::Grid { volume, cells }) = (&vs.light_volume, &d.density) {
                 progress.start(
@@ -410,6 +426,7 @@ impl Scene {
             return false;
         }
         d.tf = ClassifiedTf::new(tf, 0.0, d.tf_max, vs.step_voxels);
+        d.empty = DensityVolume::empty_space(&d.density, &d.tf);
         vs.tf = tf.clone();
         true
     }
@@ -421,7 +438,10 @@ impl Scene {
         let d = self.volume.as_ref()?;
         Some(match &d.density {
             Density::Grid { volume, cells } => {
-                let vs = VolumeScene::new(volume, cells, &d.tf, opts);
+                let mut vs = VolumeScene::new(volume, cells, &d.tf, opts);
+                if let Some(es) = &d.empty {
+                    vs = vs.with_empty_space(es);
+                }
                 Medium::Grid(match &self.light_volume {
                     Some(lv) if opts.shadows == Some(lv.shadows) => vs.with_light_volume(lv),
                     _ => vs,

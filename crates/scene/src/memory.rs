@@ -54,7 +54,7 @@ pub struct MemoryEstimate {
     pub wide_bvh: u64,
     /// Density voxels.
     pub volume: u64,
-    /// Macrocell min/max pairs (8 B/cell).
+    /// Macrocell min/max pairs (8 B/cell) and the empty-space distances (1 B/cell).
     pub macrocells: u64,
     /// Light volume (1 B/point).
     pub light_volume: u64,
@@ -131,7 +131,7 @@ impl MemoryEstimate {
                 .saturating_sub(macrocell_count(&grid) * 8);
             e.volume = grid.voxel_count() * vs.format.bytes_per_voxel() + 4;
             e.volume_dims = Some(grid.dims);
-            e.macrocells = macrocell_count(&grid) * 8;
+            e.macrocells = macrocell_count(&grid) * 9;
             if let Some(lv) = &vs.light_volume {
                 e.light_volume = grid
                     .dims
@@ -165,13 +165,13 @@ impl MemoryEstimate {
                 e.wide_bvh = md.wide().bytes() as u64;
             }
         }
-        match scene.volume.as_ref().map(|d| &d.density) {
-            Some(Density::Grid { volume, cells }) => {
+        match scene.volume.as_ref().map(|d| (&d.density, &d.empty)) {
+            Some((Density::Grid { volume, cells }, empty)) => {
                 e.volume = volume.bytes();
                 e.volume_dims = Some(volume.grid.dims);
-                e.macrocells = cells.bytes();
+                e.macrocells = cells.bytes() + empty.as_ref().map_or(0, |es| es.bytes());
             }
-            Some(Density::Particles(p)) => e.volume = p.bytes(),
+            Some((Density::Particles(p), _)) => e.volume = p.bytes(),
             None => {}
         }
         if let Some(lv) = &scene.light_volume {

@@ -92,17 +92,22 @@ fn benches(c: &mut Criterion) {
     g.sample_size(10);
     g.throughput(Throughput::Elements((size * size) as u64));
     for isa in Isa::supported() {
-        for (name, macrocells, preintegrated) in [
-            ("cells+preint", true, true),
-            ("nocells+preint", false, true),
-            ("cells+post", true, false),
+        let empty = EmptySpace::build(&mc, &tf);
+        for (name, macrocells, jumps, preintegrated) in [
+            ("jumps+preint", true, true, true),
+            ("cells+preint", true, false, true),
+            ("nocells+preint", false, false, true),
+            ("jumps+post", true, true, false),
         ] {
             let opts = MarchOptions {
                 macrocells,
                 preintegrated,
                 ..Default::default()
             };
-            let sc = VolumeScene::new(&v, &mc, &tf, opts);
+            let mut sc = VolumeScene::new(&v, &mc, &tf, opts);
+            if jumps {
+                sc = sc.with_empty_space(&empty);
+            }
             let mut out = vec![[0.0f32; 4]; size * size];
             g.bench_function(BenchmarkId::new(name, isa), |b| {
                 b.iter(|| {

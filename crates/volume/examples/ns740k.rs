@@ -98,6 +98,13 @@ fn main() {
         "classified TF (pre-integration table): {:.3} s",
         t.elapsed().as_secs_f64()
     );
+    let t = Instant::now();
+    let empty = EmptySpace::build(&mc, &ctf);
+    println!(
+        "empty-space distances: {} kB in {:.1} ms",
+        empty.bytes() / 1000,
+        t.elapsed().as_secs_f64() * 1e3
+    );
 
     // Far: whole sphere in view; close: a quarter of the distance.
     let far = extent / (20.0f32).to_radians().tan() * 1.1;
@@ -105,14 +112,24 @@ fn main() {
         let rays = synthetic::camera_rays(size, size, [0.0, 0.3 * dist, dist]);
         let tmax = vec![f32::INFINITY; size * size];
         for &isa in &isas {
-            for (macrocells, preintegrated) in [(true, true), (false, true), (true, false)] {
+            // Macrocells with empty-space jumps (the renderer's default), walked cell by
+            // cell, none; post-classification.
+            for (macrocells, jumps, preintegrated) in [
+                (true, true, true),
+                (true, false, true),
+                (false, false, true),
+                (true, true, false),
+            ] {
                 let opts = MarchOptions {
                     macrocells,
                     preintegrated,
                     lighting,
                     ..Default::default()
                 };
-                let sc = VolumeScene::new(&v, &mc, &ctf, opts);
+                let mut sc = VolumeScene::new(&v, &mc, &ctf, opts);
+                if jumps {
+                    sc = sc.with_empty_space(&empty);
+                }
                 let mut out = vec![[0.0f32; 4]; size * size];
                 let (mut best, mut cpu) = (f64::INFINITY, 0.0);
                 for _ in 0..3 {
@@ -153,7 +170,7 @@ fn main() {
                         })
                         .collect();
                     let name = format!(
-                        "{dir}/ns_{view}_{isa}_cells{macrocells}_preint{preintegrated}.png"
+                        "{dir}/ns_{view}_{isa}_cells{macrocells}_jumps{jumps}_preint{preintegrated}.png"
                     );
                     image::save_buffer(
                         &name,
@@ -166,7 +183,7 @@ fn main() {
                 }
                 let cover = out.iter().map(|c| c[3] as f64).sum::<f64>() / out.len() as f64;
                 println!(
-                    "march {view:>5} {isa:>7} cells {macrocells:<5} preint {preintegrated:<5}: {:6.2} Mrays/s wall (best of 3, {:.0} ms), {:5.2} Mrays/CPU-s, mean α {cover:.3}",
+                    "march {view:>5} {isa:>7} cells {macrocells:<5} jumps {jumps:<5} preint {preintegrated:<5}: {:6.2} Mrays/s wall (best of 3, {:.0} ms), {:5.2} Mrays/CPU-s, mean α {cover:.3}",
                     out.len() as f64 / dt / 1e6, dt * 1e3, out.len() as f64 / cpu.max(1e-3) / 1e6
                 );
             }

@@ -77,6 +77,7 @@
 
 #![warn(missing_docs)]
 
+pub mod empty_space;
 mod gradient;
 pub mod grid;
 pub mod light;
@@ -91,6 +92,7 @@ pub mod shadow;
 mod tau;
 pub mod tf;
 
+pub use empty_space::EmptySpace;
 pub use grid::{
     build_density, default_budget_bytes, density_work, estimate_bytes, DensityParams, Grid, Volume,
     VolumeData, VolumeFormat,

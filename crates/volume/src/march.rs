@@ -153,6 +153,61 @@ struct Dda<S: Simd> {
 }
 
 impl<S: Simd> Dda<S> {
+    /// The walk of `ray` from the macrocell holding its point at `t` (clamped into the grid).
+    #[inline(always)]
+    fn start(s: S, ray: &GridRay<S>, t: S::F32, ncells: [i32; 3]) -> Self {
+        let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
+        let (d, inv) = (ray.d_a(), ray.inv);
+        let mut dda = Dda::<S> {
+            c: [s.splat_i(0); 3],
+            step: [s.splat_i(1); 3],
+            tnext: [inf; 3],
+            tdelta: [inf; 3],
+            t_in: t,
+        };
+        for a in 0..3 {
+            let flat = s.eq(d[a], zero);
+            dda.step[a] = s.select_i(s.gt(d[a], zero), s.splat_i(1), s.splat_i(-1));
+            dda.tdelta[a] = s.select(flat, inf, s.abs(inv[a]) * s.splat(MACROCELL as f32));
+        }
+        dda.restart(s, ray, t, s.splat_m(true), ncells);
+        dda
+    }
+
+    /// Moves lanes `m` to the macrocell holding the ray's point at `t` (clamped into the grid).
+    #[inline(always)]
+    fn restart(&mut self, s: S, ray: &GridRay<S>, t: S::F32, m: S::M, ncells: [i32; 3]) {
+        let (zero, one, inf) = (s.splat(0.0), s.splat(1.0), s.splat(f32::INFINITY));
+        let p = ray.o.mul_add(ray.d, t);
+        let (pa, o, d) = ([p.x, p.y, p.z], ray.o_a(), ray.d_a());
+        for a in 0..3 {
+            let c = s.floor(pa[a] * s.splat(1.0 / MACROCELL as f32));
+            let c = s.min(s.max(c, zero), s.splat((ncells[a] - 1) as f32));
+            let edge = (c + s.select(s.gt(d[a], zero), one, zero)) * s.splat(MACROCELL as f32);
+            let tnext = s.select(s.eq(d[a], zero), inf, (edge - o[a]) * ray.inv[a]);
+            self.c[a] = s.select_i(m, s.to_i32(c), self.c[a]);
+            self.tnext[a] = s.select(m, tnext, self.tnext[a]);
+        }
+        self.t_in = s.select(m, t, self.t_in);
+    }
+
+    /// Exit parameter of the cube of macrocells within Chebyshev distance `r − 1` of the
+    /// current cell (`r ≥ 1` per lane).
+    #[inline(always)]
+    fn cube_exit(&self, s: S, ray: &GridRay<S>, r: S::I32) -> S::F32 {
+        let (zero, inf) = (s.splat(0.0), s.splat(f32::INFINITY));
+        let (o, d) = (ray.o_a(), ray.d_a());
+        let mut t = inf;
+        for a in 0..3 {
+            let pos = s.gt(d[a], zero);
+            let face = s.select_i(pos, self.c[a] + r, self.c[a] - r + s.splat_i(1));
+            let edge = s.to_f32(face) * s.splat(MACROCELL as f32);
+            let ta = s.select(s.eq(d[a], zero), inf, (edge - o[a]) * ray.inv[a]);
+            t = s.min(t, ta);
+        }
+        t
+    }
+
     /// Exit parameter of the current cell.
     #[inline(always)]
     fn t_out(&self, s: S) -> S::F32 {
@@ -201,9 +256,6 @@ fn march_impl<S: Simd, V: Voxels>(
     // Ray in grid coordinates (voxels); t is unchanged by the affine map.
     let ray = GridRay::from_world(s, g, orig, dir);
     let (og, dg) = (ray.o, ray.d);
-    let og_a = ray.o_a();
-    let dg_a = ray.d_a();
-    let inv_a = ray.inv;
     let span = clip_box(s, &ray, lat.hi, tmax, tf.step_voxels, active);
     let (t_in, t_end, dt) = (span.t_in, span.t_end, span.dt);
     let mut alive = span.alive;
@@ -224,29 +276,17 @@ fn march_impl<S: Simd, V: Voxels>(
     let mut need = if use_cells { alive } else { s.splat_m(false) };
     let mut marching = if use_cells { s.splat_m(false) } else { alive };
 
-    let mut dda = Dda::<S> {
-        c: [s.splat_i(0); 3],
-        step: [s.splat_i(1); 3],
-        tnext: [inf; 3],
-        tdelta: [inf; 3],
-        t_in,
-    };
-    if use_cells {
-        let inv_cell = s.splat(1.0 / MACROCELL as f32);
-        let p = og.mul_add(dg, t_in);
-        let pa = [p.x, p.y, p.z];
-        for a in 0..3 {
-            let c = s.floor(pa[a] * inv_cell);
-            let c = s.min(s.max(c, zero), s.splat((ncells[a] - 1) as f32));
-            let pos = s.gt(dg_a[a], zero);
-            let edge = (c + s.select(pos, one, zero)) * s.splat(MACROCELL as f32);
-            let flat = s.eq(dg_a[a], zero);
-            dda.c[a] = s.to_i32(c);
-            dda.step[a] = s.select_i(pos, s.splat_i(1), s.splat_i(-1));
-            dda.tnext[a] = s.select(flat, inf, (edge - og_a[a]) * inv_a[a]);
-            dda.tdelta[a] = s.select(flat, inf, s.abs(inv_a[a]) * s.splat(MACROCELL as f32));
+    let mut dda = if use_cells {
+        Dda::start(s, &ray, t_in, ncells)
+    } else {
+        Dda::<S> {
+            c: [s.splat_i(0); 3],
+            step: [s.splat_i(1); 3],
+            tnext: [inf; 3],
+            tdelta: [inf; 3],
+            t_in,
         }
-    }
+    };
 
     let lit = opts.lighting != Lighting::Unlit;
     // Lights in grid coordinates (the grid is isotropic, so directions are unchanged).
@@ -271,7 +311,21 @@ fn march_impl<S: Simd, V: Voxels>(
             if s.none(need) {
                 break;
             }
-            let ne = need & cell_occupied(s, scene.cells, tf, dda.c, ncells, need);
+            // Distance (macrocells) to the nearest non-empty cell: from the map, or 0/1 from
+            // the cell's own range (1: step to the next cell).
+            let dist = match scene.empty {
+                Some(es) => {
+                    let ci = dda.c[0]
+                        + s.mul_i(dda.c[1], s.splat_i(ncells[0]))
+                        + s.mul_i(dda.c[2], s.splat_i(ncells[0] * ncells[1]));
+                    s.gather_u8(&es.distance, ci, need)
+                }
+                None => {
+                    let occupied = cell_occupied(s, scene.cells, tf, dda.c, ncells, need);
+                    s.select_i(occupied, s.splat_i(0), s.splat_i(1))
+                }
+            };
+            let ne = need & s.eq_i(dist, s.splat_i(0));
             // First segment touching the cell (never one already composited).
             let kf = s.floor((dda.t_in - t0) / dt);
             let kf = s.select(s.gt(t0 + kf * dt, dda.t_in), kf - one, kf);
@@ -279,7 +333,13 @@ fn march_impl<S: Simd, V: Voxels>(
             cell_out = s.select(ne, dda.t_out(s), cell_out);
             marching = marching | ne;
             need = need & !ne;
-            let gone = dda.advance(s, need, ncells);
+            // Far from anything visible: jump out of the empty cube around the cell.
+            let far = need & s.gt_i(dist, s.splat_i(1));
+            if s.any(far) {
+                let t_jump = dda.cube_exit(s, &ray, dist);
+                dda.restart(s, &ray, t_jump, far, ncells);
+            }
+            let gone = dda.advance(s, need & !far, ncells);
             alive = alive & !gone;
             need = need & !gone;
         }

@@ -87,23 +87,30 @@ fn macrocell_skipping_matches_no_skipping_within_one_255th() {
                 "{preset:?}: {empty} empty cells"
             );
             let b = scattered_rays(300, 3);
+            let es = EmptySpace::build(&mc, &ctf);
             for opts in all_opts() {
-                let on = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, opts));
                 let off_opts = MarchOptions {
                     macrocells: false,
                     ..opts
                 };
                 let off = b.render(Isa::detect(), &VolumeScene::new(&v, &mc, &ctf, off_opts));
-                let mut worst = 0.0f32;
-                for (x, y) in on.iter().zip(&off) {
-                    for c in 0..4 {
-                        worst = worst.max((x[c] - y[c]).abs());
+                let cells = VolumeScene::new(&v, &mc, &ctf, opts);
+                for (sc, how) in [
+                    (cells, "cell by cell"),
+                    (cells.with_empty_space(&es), "jumps"),
+                ] {
+                    let on = b.render(Isa::detect(), &sc);
+                    let mut worst = 0.0f32;
+                    for (x, y) in on.iter().zip(&off) {
+                        for c in 0..4 {
+                            worst = worst.max((x[c] - y[c]).abs());
+                        }
                     }
+                    assert!(
+                        worst <= 1.0 / 255.0,
+                        "{format} {preset:?} {opts:?} {how}: {worst}"
+                    );
                 }
-                assert!(
-                    worst <= 1.0 / 255.0,
-                    "{format} {preset:?} {opts:?}: {worst}"
-                );
                 assert!(off.iter().filter(|c| c[3] > 0.1).count() > 30);
             }
         }
@@ -115,6 +122,7 @@ fn every_backend_agrees_with_scalar() {
     let (v, mc) = shell_scene(VolumeFormat::U8);
     let ctf = preset_tf(Preset::Viridis, v.max_value);
     let b = scattered_rays(203, 9); // not a multiple of any lane count
+    let es = EmptySpace::build(&mc, &ctf);
     for opts in all_opts().into_iter().flat_map(|o| {
         [
             o,
@@ -125,10 +133,13 @@ fn every_backend_agrees_with_scalar() {
         ]
     }) {
         let sc = VolumeScene::new(&v, &mc, &ctf, opts);
-        let want = b.render(Isa::Scalar, &sc);
-        for isa in Isa::supported() {
-            let what = |_| format!("{isa} {opts:?} against scalar");
-            assert_agree(&b.render(isa, &sc), &want, 1e-5, &what);
+        for sc in [sc, sc.with_empty_space(&es)] {
+            let want = b.render(Isa::Scalar, &sc);
+            let jumps = sc.empty.is_some();
+            for isa in Isa::supported() {
+                let what = |_| format!("{isa} {opts:?} jumps {jumps} against scalar");
+                assert_agree(&b.render(isa, &sc), &want, 1e-5, &what);
+            }
         }
     }
 }
@@ -462,4 +473,160 @@ fn light_volume_is_the_shadow_rays_on_a_shell() {
             );
         }
     }
+}
+
+#[test]
+fn early_termination_stops_at_the_first_segment_past_the_cutoff() {
+    // A constant medium: every half-voxel segment has the same opacity, so the cut-off's
+    // segment is unambiguous. Rays enter at staggered depths, so lanes of one packet pass
+    // the cut-off in different iterations while their neighbours march on.
+    let dims = [24, 12, 12];
+    let v = Volume {
+        grid: Grid {
+            origin: [0.0; 3],
+            spacing: 1.0,
+            dims,
+        },
+        data: VolumeData::F32(vec![1.0; dims.iter().product()]),
+        max_value: 1.0,
+    };
+    let mc = Macrocells::build(&v);
+    let ctf = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::Grayscale).scale_opacity(2.0),
+        0.0,
+        2.0,
+        0.5,
+    );
+    let start = |j: usize| 2.0 + 0.37 * j as f32; // entry depth of ray j, Å
+    let ray = |b: &mut Batch, j: usize, tmax: f32| {
+        let y = 3.0 + 0.25 * (j % 20) as f64;
+        b.push([-start(j) as f64, y, 5.5], [1.0, 0.0, 0.0], tmax);
+    };
+    let rays = 37;
+    for (base, _, label) in classification_opts(0.0, 0.0) {
+        for isa in Isa::supported() {
+            // Without a cut-off, ray j after n segments (tmax at the n-th segment's back).
+            let never = VolumeScene::new(
+                &v,
+                &mc,
+                &ctf,
+                MarchOptions {
+                    opacity_cutoff: 2.0,
+                    ..base
+                },
+            );
+            let mut prefix = Batch::new();
+            for j in 0..rays {
+                for n in 1..=40 {
+                    ray(&mut prefix, j, start(j) + 0.5 * n as f32);
+                }
+            }
+            let after = prefix.render(isa, &never);
+            let step = after[1][3] - after[0][3];
+            assert!(
+                after[0][3] > 0.02 && step > 0.01 && after[39][3] > 0.95,
+                "{label} {isa}: the medium must be neither too thin nor too dense: {after:?}"
+            );
+            for cutoff in [0.3f32, 0.6, 0.9] {
+                let sc = VolumeScene::new(
+                    &v,
+                    &mc,
+                    &ctf,
+                    MarchOptions {
+                        opacity_cutoff: cutoff,
+                        ..base
+                    },
+                );
+                let mut b = Batch::new();
+                for j in 0..rays {
+                    ray(&mut b, j, f32::INFINITY);
+                }
+                let got = b.render(isa, &sc);
+                for (j, g) in got.iter().enumerate() {
+                    let a = &after[40 * j..40 * (j + 1)];
+                    let n = a.iter().position(|c| c[3] >= cutoff).unwrap();
+                    for c in 0..4 {
+                        assert!(
+                            (g[c] - a[n][c]).abs() <= 1e-4,
+                            "{label} {isa} cut-off {cutoff}, ray {j}: {g:?}, want segment {} {:?}",
+                            n + 1,
+                            a[n]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn empty_space_jumps_match_the_walk_in_a_sparse_scene() {
+    // Three small clusters far apart: most macrocells are far from anything visible, so
+    // rays jump several cells at a time, in every direction, and land next to the atoms.
+    let mut a = Atoms {
+        x: vec![],
+        y: vec![],
+        z: vec![],
+        r: vec![],
+    };
+    let centres = [
+        [-20.0, -18.0, -15.0],
+        [17.0, 19.0, -16.0],
+        [2.0, 15.0, 19.0],
+    ];
+    for c in centres {
+        for (dx, dy, dz) in [(0.0, 0.0, 0.0), (1.4, 0.3, 0.0), (0.2, -1.2, 0.9)] {
+            a.x.push(c[0] + dx);
+            a.y.push(c[1] + dy);
+            a.z.push(c[2] + dz);
+            a.r.push(1.6);
+        }
+    }
+    let (v, mc) = volume_of(&a, 2.0, VolumeFormat::U8);
+    let ctf = preset_tf(Preset::CoolWarm, v.max_value);
+    let es = EmptySpace::build(&mc, &ctf);
+    assert!(
+        es.distance.iter().filter(|&&d| d >= 3).count() * 2 > es.distance.len(),
+        "the test needs mostly far-empty cells: {:?}",
+        es.dims
+    );
+    // Rays from all sides aimed at the clusters (with scatter), some missing them.
+    let mut rng = Rng(11);
+    let mut b = Batch::new();
+    for i in 0..400 {
+        let c = centres[i % 3];
+        let t: [f64; 3] = core::array::from_fn(|k| c[k] as f64 + rng.range(-3.0, 3.0));
+        let o: [f64; 3] = core::array::from_fn(|_| rng.range(-45.0, 45.0));
+        let d: [f64; 3] = core::array::from_fn(|k| t[k] - o[k]);
+        b.push(o, d, f32::INFINITY);
+    }
+    for opts in all_opts() {
+        let off = MarchOptions {
+            macrocells: false,
+            ..opts
+        };
+        let want = b.render(Isa::Scalar, &VolumeScene::new(&v, &mc, &ctf, off));
+        assert!(want.iter().filter(|c| c[3] > 0.1).count() > 100);
+        let sc = VolumeScene::new(&v, &mc, &ctf, opts).with_empty_space(&es);
+        for isa in Isa::supported() {
+            let what = |_| format!("{isa} {opts:?}: jumps against no skipping");
+            assert_agree(&b.render(isa, &sc), &want, 1.0 / 255.0, &what);
+        }
+    }
+}
+
+#[test]
+#[should_panic(expected = "another transfer function")]
+fn an_empty_space_map_of_another_transfer_function_is_refused() {
+    let (v, mc) = shell_scene(VolumeFormat::U8);
+    let a = preset_tf(Preset::CoolWarm, v.max_value);
+    let b = ClassifiedTf::new(
+        &TransferFunction::preset(Preset::CoolWarm).scale_opacity(0.0),
+        0.0,
+        v.max_value,
+        0.5,
+    );
+    let es = EmptySpace::build(&mc, &a);
+    assert!(es.matches(&mc, &a) && !es.matches(&mc, &b));
+    let _ = VolumeScene::new(&v, &mc, &b, MarchOptions::default()).with_empty_space(&es);
 }

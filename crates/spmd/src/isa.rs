@@ -13,7 +13,7 @@ pub enum Isa {
     Scalar,
     /// SSE4.1, 4 lanes.
     Sse41,
-    /// AVX2 + FMA, 8 lanes.
+    /// AVX2 + FMA + F16C, 8 lanes.
     Avx2,
     /// AVX-512F, 16 lanes with mask registers.
     Avx512,

@@ -190,6 +190,18 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     fn bitcast_i(self, a: Self::F32) -> Self::I32;
     /// Reinterprets the bits of each lane.
     fn bitcast_f(self, a: Self::I32) -> Self::F32;
+    /// The IEEE binary16 values in bits 0-15 and in bits 16-31 of each lane as f32, exactly
+    /// (subnormal halves become normal f32s; infinities and NaNs stay so), with the sign bits
+    /// 15 and 31 ignored. AVX2 and AVX-512 convert in hardware (F16C); the default works in
+    /// the integers, never through an f32 subnormal (an x86 op on one takes a microcode
+    /// assist).
+    #[inline(always)]
+    fn halves(self, w: Self::I32) -> (Self::F32, Self::F32) {
+        (
+            half_magnitude(self, w & self.splat_i(0x7fff)),
+            half_magnitude(self, self.shr(w, 16) & self.splat_i(0x7fff)),
+        )
+    }
 
     // ----- masks -----
 
@@ -234,6 +246,51 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
     /// of a quantised volume in one gather. Panics if an active lane's `idx` is outside `s`, as
     /// [`Simd::gather`].
     fn gather_u8x4(self, s: &[u8], idx: Self::I32, m: Self::M) -> Self::I32;
+    /// [`Simd::gather_i`] at `idx + o` for each offset `o` of `off` (all `≥ 0`), inactive
+    /// lanes 0: neighbouring entries of a table, e.g. one record's fields. The SIMD backends
+    /// check the bounds once (`0 ≤ idx < len − max(off)` on every active lane). Panics if
+    /// an offset is negative or an active lane reads outside `s`, as [`Simd::gather`].
+    #[inline(always)]
+    fn gather_i_rows<const N: usize>(
+        self,
+        s: &[i32],
+        idx: Self::I32,
+        off: [i32; N],
+        m: Self::M,
+    ) -> [Self::I32; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_i_rows: negative offset"
+        );
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
+        }
+        out
+    }
+    /// [`Simd::gather_u8x4`] at `idx + o` for each offset `o` of `off` (all `≥ 0`): several
+    /// rows of a lattice around one index, e.g. a trilinear cell's four x-rows. The SIMD
+    /// backends check the bounds once for all rows (`0 ≤ idx ≤ len − 4 − max(off)` on every
+    /// active lane) and take the per-row path only when that fails. Panics if an offset is
+    /// negative or an active lane reads outside `s`, as [`Simd::gather`].
+    #[inline(always)]
+    fn gather_u8x4_rows<const N: usize>(
+        self,
+        s: &[u8],
+        idx: Self::I32,
+        off: [i32; N],
+        m: Self::M,
+    ) -> [Self::I32; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_u8x4_rows: negative offset"
+        );
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
+        }
+        out
+    }
 }
 
 /// The four bytes of `s` from `i` on as a little-endian `i32`, zero past the end (the lane
@@ -248,6 +305,20 @@ fn le_bytes4(s: &[u8], i: usize) -> i32 {
             i32::from_le_bytes(w)
         }
     }
+}
+
+/// The binary16 magnitude `h < 2¹⁵` of each lane as f32, in the integers: a normal half's
+/// exponent and mantissa moved into place and its exponent rebiased by 112, a subnormal one
+/// (`h < 2¹⁰`) as `h·2⁻²⁴` (exact: an integer below 2¹⁰ times a power of two), infinity and
+/// NaN (`h ≥ 0x7c00`) with the f32 exponent of all ones and the same mantissa bits.
+#[inline(always)]
+fn half_magnitude<S: Simd>(s: S, h: S::I32) -> S::F32 {
+    let moved = s.shl(h, 13);
+    let normal = s.bitcast_f(moved + s.splat_i(112 << 23));
+    let special = s.bitcast_f(moved | s.splat_i(0x7f80_0000));
+    let subnormal = s.to_f32(h) * s.splat(f32::from_bits(0x3380_0000)); // 2⁻²⁴
+    let finite = s.select(s.lt_i(h, s.splat_i(0x400)), subnormal, normal);
+    s.select(s.gt_i(h, s.splat_i(0x7bff)), special, finite)
 }
 
 /// Panics unless every active lane's index is inside a slice of `len` elements.

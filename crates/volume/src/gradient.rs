@@ -57,20 +57,6 @@ fn sub2<S: Simd>(a: [S::F32; 2], b: [S::F32; 2]) -> [S::F32; 2] {
     [a[0] - b[0], a[1] - b[1]]
 }
 
-/// The two x-neighbours at lattice offset `(y, z)` from index `b`.
-#[inline(always)]
-fn pair<S: Simd, V: Voxels>(
-    s: S,
-    l: &Lattice<V>,
-    b: S::I32,
-    y: i32,
-    z: i32,
-    m: S::M,
-) -> [S::F32; 2] {
-    let (a, c) = l.vox.fetch2(s, b + s.splat_i(y * l.nx + z * l.nxy), m);
-    [a, c]
-}
-
 // Paper §4.4: the trilinear sample at `p` and the x-part of its central-difference gradient,
 // from the cell's four x-rows read one voxel wider.
 #[inline(always)]
@@ -83,13 +69,9 @@ pub(crate) fn sample_stencil<S: Simd, V: Voxels>(
     let cell = cell_of(s, l, p);
     let inside = inside(s, l, &cell);
     let at = m & inside;
-    let (nx, nxy) = (s.splat_i(l.nx), s.splat_i(l.nxy));
     let r0 = cell.b - s.splat_i(1);
     // r[z][y] = v[x − 1 ..= x + 2] at (y, z) of the cell.
-    let r00 = l.vox.fetch4(s, r0, at);
-    let r01 = l.vox.fetch4(s, r0 + nx, at);
-    let r10 = l.vox.fetch4(s, r0 + nxy, at);
-    let r11 = l.vox.fetch4(s, r0 + nxy + nx, at);
+    let [r00, r01, r10, r11] = l.vox.fetch4_rows(s, r0, [0, l.nx, l.nxy, l.nxy + l.nx], at);
     let v = [
         [[r00[1], r00[2]], [r01[1], r01[2]]],
         [[r10[1], r10[2]], [r11[1], r11[2]]],
@@ -122,27 +104,44 @@ fn gradient_yz<S: Simd, V: Voxels>(
     st: &Stencil<S>,
     m: S::M,
 ) -> (S::F32, S::F32) {
-    let (b, v) = (st.cell.b, &st.v);
+    let v = &st.v;
+    // The eight rows one voxel beyond the cell along y and z, from the lattice point one row
+    // back in y and in z (so every offset is ≥ 0; inside lanes have that point).
+    let (nx, nxy) = (l.nx, l.nxy);
+    let base = st.cell.b - s.splat_i(nx + nxy);
+    // (y, z) = (−1, 0), (2, 0), (−1, 1), (2, 1), then (0, −1), (1, −1), (0, 2), (1, 2).
+    let offsets = [
+        nxy,
+        3 * nx + nxy,
+        2 * nxy,
+        3 * nx + 2 * nxy,
+        nx,
+        2 * nx,
+        nx + 3 * nxy,
+        2 * nx + 3 * nxy,
+    ];
+    let [ym_z0, yp_z0, ym_z1, yp_z1, zm_y0, zm_y1, zp_y0, zp_y1] =
+        l.vox.fetch2_rows(s, base, offsets, m);
     // d[z][y] = v(·, y + 1, z) − v(·, y − 1, z) at the cell's corners.
     let dy = [
         [
-            sub2::<S>(v[0][1], pair(s, l, b, -1, 0, m)),
-            sub2::<S>(pair(s, l, b, 2, 0, m), v[0][0]),
+            sub2::<S>(v[0][1], [ym_z0.0, ym_z0.1]),
+            sub2::<S>([yp_z0.0, yp_z0.1], v[0][0]),
         ],
         [
-            sub2::<S>(v[1][1], pair(s, l, b, -1, 1, m)),
-            sub2::<S>(pair(s, l, b, 2, 1, m), v[1][0]),
+            sub2::<S>(v[1][1], [ym_z1.0, ym_z1.1]),
+            sub2::<S>([yp_z1.0, yp_z1.1], v[1][0]),
         ],
     ];
     // d[z][y] = v(·, y, z + 1) − v(·, y, z − 1).
     let dz = [
         [
-            sub2::<S>(v[1][0], pair(s, l, b, 0, -1, m)),
-            sub2::<S>(v[1][1], pair(s, l, b, 1, -1, m)),
+            sub2::<S>(v[1][0], [zm_y0.0, zm_y0.1]),
+            sub2::<S>(v[1][1], [zm_y1.0, zm_y1.1]),
         ],
         [
-            sub2::<S>(pair(s, l, b, 0, 2, m), v[0][0]),
-            sub2::<S>(pair(s, l, b, 1, 2, m), v[0][1]),
+            sub2::<S>([zp_y0.0, zp_y0.1], v[0][0]),
+            sub2::<S>([zp_y1.0, zp_y1.1], v[0][1]),
         ],
     ];
     let scale = s.splat(l.scale);

@@ -21,6 +21,31 @@ pub(crate) trait Voxels: Copy {
     fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32);
     /// `m ? value[idx .. idx + 4] : 0`: four x-neighbours (raw units).
     fn fetch4<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> [S::F32; 4];
+    /// [`Voxels::fetch2`] at `idx + o` for each row offset `o` of `off` (all `≥ 0`).
+    #[inline(always)]
+    fn fetch2_rows<S: Simd, const N: usize>(
+        self,
+        s: S,
+        idx: S::I32,
+        off: [i32; N],
+        m: S::M,
+    ) -> [(S::F32, S::F32); N] {
+        let mut out = [(s.splat(0.0), s.splat(0.0)); N];
+        for (v, o) in out.iter_mut().zip(off) {
+            *v = self.fetch2(s, idx + s.splat_i(o), m);
+        }
+        out
+    }
+    /// [`Voxels::fetch4`] at `idx + o` for the four row offsets `off` (all `≥ 0`).
+    #[inline(always)]
+    fn fetch4_rows<S: Simd>(self, s: S, idx: S::I32, off: [i32; 4], m: S::M) -> [[S::F32; 4]; 4] {
+        [
+            self.fetch4(s, idx + s.splat_i(off[0]), m),
+            self.fetch4(s, idx + s.splat_i(off[1]), m),
+            self.fetch4(s, idx + s.splat_i(off[2]), m),
+            self.fetch4(s, idx + s.splat_i(off[3]), m),
+        ]
+    }
 }
 
 /// f32 voxels (density units).
@@ -49,22 +74,53 @@ impl Voxels for U8Voxels<'_> {
     // volume at 1024², AVX-512, 1 thread, old and new side by side: 5.32 → 4.16 s (1.28×).
     #[inline(always)]
     fn fetch2<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> (S::F32, S::F32) {
-        let w = s.gather_u8x4(self.0, idx, m);
-        let ff = s.splat_i(0xff);
-        (s.to_f32(w & ff), s.to_f32(s.shr(w, 8) & ff))
+        bytes2(s, s.gather_u8x4(self.0, idx, m))
     }
     // The same single 4-byte gather, all four bytes used.
     #[inline(always)]
     fn fetch4<S: Simd>(self, s: S, idx: S::I32, m: S::M) -> [S::F32; 4] {
-        let w = s.gather_u8x4(self.0, idx, m);
-        let ff = s.splat_i(0xff);
-        [
-            s.to_f32(w & ff),
-            s.to_f32(s.shr(w, 8) & ff),
-            s.to_f32(s.shr(w, 16) & ff),
-            s.to_f32(s.shr(w, 24) & ff),
-        ]
+        bytes4(s, s.gather_u8x4(self.0, idx, m))
     }
+    // The rows' gathers behind one bounds check.
+    #[inline(always)]
+    fn fetch2_rows<S: Simd, const N: usize>(
+        self,
+        s: S,
+        idx: S::I32,
+        off: [i32; N],
+        m: S::M,
+    ) -> [(S::F32, S::F32); N] {
+        let w = s.gather_u8x4_rows(self.0, idx, off, m);
+        let mut out = [(s.splat(0.0), s.splat(0.0)); N];
+        for (v, w) in out.iter_mut().zip(w) {
+            *v = bytes2(s, w);
+        }
+        out
+    }
+    #[inline(always)]
+    fn fetch4_rows<S: Simd>(self, s: S, idx: S::I32, off: [i32; 4], m: S::M) -> [[S::F32; 4]; 4] {
+        let [a, b, c, d] = s.gather_u8x4_rows(self.0, idx, off, m);
+        [bytes4(s, a), bytes4(s, b), bytes4(s, c), bytes4(s, d)]
+    }
+}
+
+/// Bytes 0 and 1 of each lane as f32.
+#[inline(always)]
+fn bytes2<S: Simd>(s: S, w: S::I32) -> (S::F32, S::F32) {
+    let ff = s.splat_i(0xff);
+    (s.to_f32(w & ff), s.to_f32(s.shr(w, 8) & ff))
+}
+
+/// Bytes 0-3 of each lane as f32.
+#[inline(always)]
+fn bytes4<S: Simd>(s: S, w: S::I32) -> [S::F32; 4] {
+    let ff = s.splat_i(0xff);
+    [
+        s.to_f32(w & ff),
+        s.to_f32(s.shr(w, 8) & ff),
+        s.to_f32(s.shr(w, 16) & ff),
+        s.to_f32(s.shr(w, 24) & ff),
+    ]
 }
 
 /// Uniform lattice facts the sampler needs.
@@ -269,12 +325,9 @@ pub(crate) fn blend<S: Simd>(v: [[[S::F32; 2]; 2]; 2], f: [S::F32; 3]) -> S::F32
 #[inline(always)]
 pub(crate) fn trilinear<S: Simd, V: Voxels>(s: S, l: &Lattice<V>, p: V3<S>, m: S::M) -> S::F32 {
     let c = cell_of(s, l, p);
-    let (nx, nxy) = (s.splat_i(l.nx), s.splat_i(l.nxy));
-    let (v000, v100) = l.vox.fetch2(s, c.b, m);
-    let (v010, v110) = l.vox.fetch2(s, c.b + nx, m);
-    let b1 = c.b + nxy;
-    let (v001, v101) = l.vox.fetch2(s, b1, m);
-    let (v011, v111) = l.vox.fetch2(s, b1 + nx, m);
+    let rows = [0, l.nx, l.nxy, l.nxy + l.nx];
+    let [(v000, v100), (v010, v110), (v001, v101), (v011, v111)] =
+        l.vox.fetch2_rows(s, c.b, rows, m);
     let v = [[[v000, v100], [v010, v110]], [[v001, v101], [v011, v111]]];
     blend::<S>(v, c.f) * s.splat(l.scale)
 }

@@ -5,30 +5,33 @@ use core::arch::x86_64::*;
 use super::{assignops, binops, check_lanes};
 use crate::{le_bytes4, Isa, Kernel, Simd};
 
-/// Runs AVX2 and FMA intrinsics. SAFETY: only used on values of this file's types, whose existence
-/// proves AVX2 and FMA support (see the module docs of `x86`); memory accesses are bounds-checked
+/// Runs AVX2, FMA and F16C intrinsics. SAFETY: only used on values of this file's types, whose existence
+/// proves AVX2, FMA and F16C support (see the module docs of `x86`); memory accesses are bounds-checked
 /// by the caller as stated at each use.
 macro_rules! simd {
     ($e:expr) => {{
         #[allow(unused_unsafe, clippy::macro_metavars_in_unsafe)]
-        // SAFETY: see the macro's doc comment: the CPU supports AVX2 and FMA.
+        // SAFETY: see the macro's doc comment: the CPU supports AVX2, FMA and F16C.
         unsafe {
             $e
         }
     }};
 }
 
-/// AVX2 + FMA backend token (8 lanes).
+/// AVX2 + FMA + F16C backend token (8 lanes).
 #[derive(Clone, Copy, Debug)]
 pub struct Avx2 {
     _private: (),
 }
 
 impl Avx2 {
-    /// The token, if this CPU supports AVX2 and FMA.
+    /// The token, if this CPU supports AVX2, FMA and F16C (every AVX2 CPU from Intel and AMD
+    /// has F16C).
     pub fn try_new() -> Option<Avx2> {
-        (is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"))
-            .then_some(Avx2 { _private: () })
+        (is_x86_feature_detected!("avx2")
+            && is_x86_feature_detected!("fma")
+            && is_x86_feature_detected!("f16c"))
+        .then_some(Avx2 { _private: () })
     }
 }
 
@@ -345,6 +348,22 @@ impl Simd for Avx2 {
         a[1..].iter().fold(a[0], |acc, &x| acc + x)
     }
 
+    // F16C in hardware: the low and high halves packed to words (exact: both below 2¹⁵),
+    // the 128-bit lanes reordered so each half's eight sit together, then widened (vcvtph2ps).
+    #[inline(always)]
+    fn halves(self, w: I32x8) -> (F32x8, F32x8) {
+        let m = simd!(_mm256_set1_epi32(0x7fff));
+        let lo = simd!(_mm256_and_si256(w.0, m));
+        let hi = simd!(_mm256_and_si256(_mm256_srli_epi32::<16>(w.0), m));
+        let q = simd!(_mm256_permute4x64_epi64::<0b11_01_10_00>(
+            _mm256_packus_epi32(lo, hi)
+        ));
+        (
+            F32x8(simd!(_mm256_cvtph_ps(_mm256_castsi256_si128(q)))),
+            F32x8(simd!(_mm256_cvtph_ps(_mm256_extracti128_si256::<1>(q)))),
+        )
+    }
+
     #[inline(always)]
     fn gather(self, s: &[f32], idx: I32x8, m: M32x8, fill: F32x8) -> F32x8 {
         let m = active_in_bounds(self, idx, m, s.len(), 1);
@@ -367,6 +386,85 @@ impl Simd for Avx2 {
             idx.0,
             _mm256_castps_si256(m.0)
         )))
+    }
+    // One unsigned compare bounds every entry, as in `gather_u8x4_rows`.
+    #[inline(always)]
+    fn gather_i_rows<const N: usize>(
+        self,
+        s: &[i32],
+        idx: I32x8,
+        off: [i32; N],
+        m: M32x8,
+    ) -> [I32x8; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_i_rows: negative offset"
+        );
+        let top = off.iter().copied().max().unwrap_or(0) as i64;
+        let hi = s.len().min(i32::MAX as usize) as i64 - 1 - top;
+        let bad = m & self.gt_i(
+            idx ^ self.splat_i(i32::MIN),
+            self.splat_i(hi as i32 ^ i32::MIN),
+        );
+        let mut out = [self.splat_i(0); N];
+        if hi < 0 || self.any(bad) {
+            for (w, o) in out.iter_mut().zip(off) {
+                *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
+            }
+            return out;
+        }
+        for (w, o) in out.iter_mut().zip(off) {
+            // Bounds: every active lane reads s[idx + o] with 0 ≤ idx + o < len (checked
+            // just above).
+            *w = I32x8(simd!(_mm256_mask_i32gather_epi32::<4>(
+                _mm256_setzero_si256(),
+                s.as_ptr(),
+                (idx + self.splat_i(o)).0,
+                _mm256_castps_si256(m.0)
+            )));
+        }
+        out
+    }
+    // One unsigned compare bounds every row: `idx ≤ len − 4 − max(off)` as u32 also rules
+    // out `idx < 0`, and each row's `idx + o` then lies in `[0, len − 4]`.
+    #[inline(always)]
+    fn gather_u8x4_rows<const N: usize>(
+        self,
+        s: &[u8],
+        idx: I32x8,
+        off: [i32; N],
+        m: M32x8,
+    ) -> [I32x8; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_u8x4_rows: negative offset"
+        );
+        let top = off.iter().copied().max().unwrap_or(0) as i64;
+        let hi = s.len().min(i32::MAX as usize) as i64 - 4 - top;
+        let bad = m & self.gt_i(
+            idx ^ self.splat_i(i32::MIN),
+            self.splat_i(hi as i32 ^ i32::MIN),
+        );
+        if hi < 0 || self.any(bad) {
+            let mut out = [self.splat_i(0); N];
+            for (w, o) in out.iter_mut().zip(off) {
+                *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
+            }
+            return out;
+        }
+        // No closure (it would not inherit the entry point's target features).
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            *w = // Bounds: every active lane reads s[idx + o .. idx + o + 4] with
+                // 0 ≤ idx + o ≤ len − 4 (checked just above).
+                I32x8(simd!(_mm256_mask_i32gather_epi32::<1>(
+                    _mm256_setzero_si256(),
+                    s.as_ptr().cast::<i32>(),
+                    (idx + self.splat_i(o)).0,
+                    _mm256_castps_si256(m.0)
+                )));
+        }
+        out
     }
     #[inline(always)]
     fn gather_u8x4(self, s: &[u8], idx: I32x8, m: M32x8) -> I32x8 {
@@ -416,17 +514,17 @@ fn active_in_bounds(s: Avx2, idx: I32x8, m: M32x8, len: usize, width: i32) -> M3
     m
 }
 
-/// Runs `k` compiled for AVX2 + FMA. Panics if the CPU lacks them.
+/// Runs `k` compiled for AVX2 + FMA + F16C. Panics if the CPU lacks them.
 pub(crate) fn dispatch<K: Kernel>(k: K) -> K::Output {
-    let s = Avx2::try_new().expect("AVX2 backend dispatched on a CPU without AVX2 and FMA");
-    // SAFETY: `try_new` just confirmed AVX2 and FMA, the features `entry` enables.
+    let s = Avx2::try_new().expect("AVX2 backend dispatched on a CPU without AVX2, FMA and F16C");
+    // SAFETY: `try_new` just confirmed AVX2, FMA and F16C, the features `entry` enables.
     unsafe { entry(s, k) }
 }
 
 // Not inlined: one call per task, and a named symbol whose assembly can be checked
 // (`cargo xtask asm`).
 #[inline(never)]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2,fma,f16c")]
 fn entry<K: Kernel>(s: Avx2, k: K) -> K::Output {
     k.run(s)
 }

@@ -380,6 +380,18 @@ impl Simd for Avx512 {
         a[1..].iter().fold(a[0], |acc, &x| acc + x)
     }
 
+    // F16C in hardware: each half truncated out of its lane (vpmovdw) and widened
+    // (vcvtph2ps), exact for every half.
+    #[inline(always)]
+    fn halves(self, w: I32x16) -> (F32x16, F32x16) {
+        let w = simd!(_mm512_and_si512(w.0, _mm512_set1_epi32(0x7fff_7fff)));
+        let lo = simd!(_mm512_cvtph_ps(_mm512_cvtepi32_epi16(w)));
+        let hi = simd!(_mm512_cvtph_ps(_mm512_cvtepi32_epi16(_mm512_srli_epi32::<
+            16,
+        >(w))));
+        (F32x16(lo), F32x16(hi))
+    }
+
     #[inline(always)]
     fn gather(self, s: &[f32], idx: I32x16, m: M16, fill: F32x16) -> F32x16 {
         let m = active_in_bounds(self, idx, m, s.len(), 1);
@@ -402,6 +414,85 @@ impl Simd for Avx512 {
             idx.0,
             s.as_ptr()
         )))
+    }
+    // One unsigned compare bounds every entry, as in `gather_u8x4_rows`.
+    #[inline(always)]
+    fn gather_i_rows<const N: usize>(
+        self,
+        s: &[i32],
+        idx: I32x16,
+        off: [i32; N],
+        m: M16,
+    ) -> [I32x16; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_i_rows: negative offset"
+        );
+        let top = off.iter().copied().max().unwrap_or(0) as i64;
+        let hi = s.len().min(i32::MAX as usize) as i64 - 1 - top;
+        let bad = m & M16(simd!(_mm512_cmpgt_epu32_mask(
+            idx.0,
+            _mm512_set1_epi32(hi as i32)
+        )));
+        let mut out = [self.splat_i(0); N];
+        if hi < 0 || self.any(bad) {
+            for (w, o) in out.iter_mut().zip(off) {
+                *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
+            }
+            return out;
+        }
+        for (w, o) in out.iter_mut().zip(off) {
+            // Bounds: every active lane reads s[idx + o] with 0 ≤ idx + o < len (checked
+            // just above).
+            *w = I32x16(simd!(_mm512_mask_i32gather_epi32::<4>(
+                _mm512_setzero_si512(),
+                m.0,
+                (idx + self.splat_i(o)).0,
+                s.as_ptr()
+            )));
+        }
+        out
+    }
+    // One unsigned compare bounds every row: `idx ≤ len − 4 − max(off)` as u32 also rules
+    // out `idx < 0`, and each row's `idx + o` then lies in `[0, len − 4]`.
+    #[inline(always)]
+    fn gather_u8x4_rows<const N: usize>(
+        self,
+        s: &[u8],
+        idx: I32x16,
+        off: [i32; N],
+        m: M16,
+    ) -> [I32x16; N] {
+        assert!(
+            off.iter().all(|&o| o >= 0),
+            "gather_u8x4_rows: negative offset"
+        );
+        let top = off.iter().copied().max().unwrap_or(0) as i64;
+        let hi = s.len().min(i32::MAX as usize) as i64 - 4 - top;
+        let bad = m & M16(simd!(_mm512_cmpgt_epu32_mask(
+            idx.0,
+            _mm512_set1_epi32(hi as i32)
+        )));
+        if hi < 0 || self.any(bad) {
+            let mut out = [self.splat_i(0); N];
+            for (w, o) in out.iter_mut().zip(off) {
+                *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
+            }
+            return out;
+        }
+        // No closure (it would not inherit the entry point's target features).
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            *w = // Bounds: every active lane reads s[idx + o .. idx + o + 4] with
+                // 0 ≤ idx + o ≤ len − 4 (checked just above).
+                I32x16(simd!(_mm512_mask_i32gather_epi32::<1>(
+                    _mm512_setzero_si512(),
+                    m.0,
+                    (idx + self.splat_i(o)).0,
+                    s.as_ptr().cast::<i32>()
+                )));
+        }
+        out
     }
     #[inline(always)]
     fn gather_u8x4(self, s: &[u8], idx: I32x16, m: M16) -> I32x16 {

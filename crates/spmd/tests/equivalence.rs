@@ -822,8 +822,14 @@ fn row_gathers_match_a_lane_reference_and_check_bounds() {
                     })
                 })
             };
-            assert!(run(u32::MAX).is_err(), "{isa}: row gather at {bad} did not panic");
-            assert!(run(!(1 << (lanes - 1))).is_ok(), "{isa}: inactive lane at {bad} panicked");
+            assert!(
+                run(u32::MAX).is_err(),
+                "{isa}: row gather at {bad} did not panic"
+            );
+            assert!(
+                run(!(1 << (lanes - 1))).is_ok(),
+                "{isa}: inactive lane at {bad} panicked"
+            );
         }
     }
 }

@@ -258,15 +258,7 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
         off: [i32; N],
         m: Self::M,
     ) -> [Self::I32; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_i_rows: negative offset"
-        );
-        let mut out = [self.splat_i(0); N];
-        for (w, o) in out.iter_mut().zip(off) {
-            *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
-        }
-        out
+        gather_rows_each(self, s, idx, off, m)
     }
     /// [`Simd::gather_u8x4`] at `idx + o` for each offset `o` of `off` (all `≥ 0`): several
     /// rows of a lattice around one index, e.g. a trilinear cell's four x-rows. The SIMD
@@ -281,16 +273,70 @@ pub trait Simd: Copy + Send + Sync + Debug + 'static {
         off: [i32; N],
         m: Self::M,
     ) -> [Self::I32; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_u8x4_rows: negative offset"
-        );
-        let mut out = [self.splat_i(0); N];
-        for (w, o) in out.iter_mut().zip(off) {
-            *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
-        }
-        out
+        gather_rows_each(self, s, idx, off, m)
     }
+}
+
+/// A slice the row gathers ([`Simd::gather_i_rows`], [`Simd::gather_u8x4_rows`]) read: how
+/// far one read reaches past its index, and that single checked gather.
+pub(crate) trait RowTable {
+    /// Elements one read spans (4 bytes of a `u8` slice, one `i32`).
+    const SPAN: i64;
+    /// Elements in the slice.
+    fn elements(&self) -> usize;
+    /// The checked single gather at `idx` (inactive lanes 0).
+    fn gather_at<S: Simd>(&self, s: S, idx: S::I32, m: S::M) -> S::I32;
+}
+
+impl RowTable for [u8] {
+    const SPAN: i64 = 4;
+    #[inline(always)]
+    fn elements(&self) -> usize {
+        self.len()
+    }
+    #[inline(always)]
+    fn gather_at<S: Simd>(&self, s: S, idx: S::I32, m: S::M) -> S::I32 {
+        s.gather_u8x4(self, idx, m)
+    }
+}
+
+impl RowTable for [i32] {
+    const SPAN: i64 = 1;
+    #[inline(always)]
+    fn elements(&self) -> usize {
+        self.len()
+    }
+    #[inline(always)]
+    fn gather_at<S: Simd>(&self, s: S, idx: S::I32, m: S::M) -> S::I32 {
+        s.gather_i(self, idx, m, s.splat_i(0))
+    }
+}
+
+/// The largest start index from which every row `idx + o` of `off` reads inside `t`
+/// (`len − span − max(off)`; negative when none does). Panics if an offset is negative.
+#[inline(always)]
+pub(crate) fn rows_last_start<T: RowTable + ?Sized>(t: &T, off: &[i32]) -> i64 {
+    assert!(off.iter().all(|&o| o >= 0), "row gather: negative offset");
+    let top = off.iter().copied().max().unwrap_or(0) as i64;
+    t.elements().min(i32::MAX as usize) as i64 - T::SPAN - top
+}
+
+/// Each row of a row gather by its own checked gather: the trait's default and the SIMD
+/// backends' path when one check does not cover every row. Panics if an offset is negative.
+#[inline(always)]
+pub(crate) fn gather_rows_each<S: Simd, T: RowTable + ?Sized, const N: usize>(
+    s: S,
+    t: &T,
+    idx: S::I32,
+    off: [i32; N],
+    m: S::M,
+) -> [S::I32; N] {
+    rows_last_start(t, &off);
+    let mut out = [s.splat_i(0); N];
+    for (w, o) in out.iter_mut().zip(off) {
+        *w = t.gather_at(s, idx + s.splat_i(o), m);
+    }
+    out
 }
 
 /// The four bytes of `s` from `i` on as a little-endian `i32`, zero past the end (the lane

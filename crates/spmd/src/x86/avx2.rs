@@ -3,7 +3,7 @@
 use core::arch::x86_64::*;
 
 use super::{assignops, binops, check_lanes};
-use crate::{le_bytes4, Isa, Kernel, Simd};
+use crate::{gather_rows_each, le_bytes4, rows_last_start, Isa, Kernel, Simd};
 
 /// Runs AVX2, FMA and F16C intrinsics. SAFETY: only used on values of this file's types, whose existence
 /// proves AVX2, FMA and F16C support (see the module docs of `x86`); memory accesses are bounds-checked
@@ -72,6 +72,43 @@ impl core::ops::Not for M32x8 {
 #[inline(always)]
 fn count(n: u32) -> __m128i {
     simd!(_mm_cvtsi32_si128(n as i32))
+}
+
+impl Avx2 {
+    /// True when `last ≥ 0` and every active lane has `idx ≤ last` as u32 (so `idx ≥ 0`;
+    /// the unsigned compare as a signed one with the sign bits flipped).
+    #[inline(always)]
+    fn rows_fit(self, idx: I32x8, m: M32x8, last: i64) -> bool {
+        let flip = self.splat_i(i32::MIN);
+        let top = self.splat_i(last.clamp(0, i32::MAX as i64) as i32);
+        last >= 0 && self.none(m & self.gt_i(idx ^ flip, top ^ flip))
+    }
+
+    /// The 4-byte words at `base + (idx + o)·SCALE` bytes for each offset `o` of `off`,
+    /// active lanes only (no closure: it would not inherit the entry's target features).
+    ///
+    /// # Safety
+    /// Every active lane's 4 bytes at each such address must lie inside one allocation.
+    #[inline(always)]
+    unsafe fn gather_words<const SCALE: i32, const N: usize>(
+        self,
+        base: *const u8,
+        idx: I32x8,
+        off: [i32; N],
+        m: M32x8,
+    ) -> [I32x8; N] {
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            // Bounds: the caller's contract.
+            *w = I32x8(simd!(_mm256_mask_i32gather_epi32::<SCALE>(
+                _mm256_setzero_si256(),
+                base.cast::<i32>(),
+                (idx + self.splat_i(o)).0,
+                _mm256_castps_si256(m.0)
+            )));
+        }
+        out
+    }
 }
 
 impl Simd for Avx2 {
@@ -396,34 +433,11 @@ impl Simd for Avx2 {
         off: [i32; N],
         m: M32x8,
     ) -> [I32x8; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_i_rows: negative offset"
-        );
-        let top = off.iter().copied().max().unwrap_or(0) as i64;
-        let hi = s.len().min(i32::MAX as usize) as i64 - 1 - top;
-        let bad = m & self.gt_i(
-            idx ^ self.splat_i(i32::MIN),
-            self.splat_i(hi as i32 ^ i32::MIN),
-        );
-        let mut out = [self.splat_i(0); N];
-        if hi < 0 || self.any(bad) {
-            for (w, o) in out.iter_mut().zip(off) {
-                *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
-            }
-            return out;
+        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
+            return gather_rows_each(self, s, idx, off, m);
         }
-        for (w, o) in out.iter_mut().zip(off) {
-            // Bounds: every active lane reads s[idx + o] with 0 ≤ idx + o < len (checked
-            // just above).
-            *w = I32x8(simd!(_mm256_mask_i32gather_epi32::<4>(
-                _mm256_setzero_si256(),
-                s.as_ptr(),
-                (idx + self.splat_i(o)).0,
-                _mm256_castps_si256(m.0)
-            )));
-        }
-        out
+        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 1]`.
+        unsafe { self.gather_words::<4, N>(s.as_ptr().cast(), idx, off, m) }
     }
     // One unsigned compare bounds every row: `idx ≤ len − 4 − max(off)` as u32 also rules
     // out `idx < 0`, and each row's `idx + o` then lies in `[0, len − 4]`.
@@ -435,36 +449,11 @@ impl Simd for Avx2 {
         off: [i32; N],
         m: M32x8,
     ) -> [I32x8; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_u8x4_rows: negative offset"
-        );
-        let top = off.iter().copied().max().unwrap_or(0) as i64;
-        let hi = s.len().min(i32::MAX as usize) as i64 - 4 - top;
-        let bad = m & self.gt_i(
-            idx ^ self.splat_i(i32::MIN),
-            self.splat_i(hi as i32 ^ i32::MIN),
-        );
-        if hi < 0 || self.any(bad) {
-            let mut out = [self.splat_i(0); N];
-            for (w, o) in out.iter_mut().zip(off) {
-                *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
-            }
-            return out;
+        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
+            return gather_rows_each(self, s, idx, off, m);
         }
-        // No closure (it would not inherit the entry point's target features).
-        let mut out = [self.splat_i(0); N];
-        for (w, o) in out.iter_mut().zip(off) {
-            *w = // Bounds: every active lane reads s[idx + o .. idx + o + 4] with
-                // 0 ≤ idx + o ≤ len − 4 (checked just above).
-                I32x8(simd!(_mm256_mask_i32gather_epi32::<1>(
-                    _mm256_setzero_si256(),
-                    s.as_ptr().cast::<i32>(),
-                    (idx + self.splat_i(o)).0,
-                    _mm256_castps_si256(m.0)
-                )));
-        }
-        out
+        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 4]`.
+        unsafe { self.gather_words::<1, N>(s.as_ptr(), idx, off, m) }
     }
     #[inline(always)]
     fn gather_u8x4(self, s: &[u8], idx: I32x8, m: M32x8) -> I32x8 {

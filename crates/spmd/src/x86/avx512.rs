@@ -4,7 +4,7 @@
 use core::arch::x86_64::*;
 
 use super::{assignops, binops, check_lanes};
-use crate::{le_bytes4, Isa, Kernel, Simd};
+use crate::{gather_rows_each, le_bytes4, rows_last_start, Isa, Kernel, Simd};
 
 /// Runs AVX-512F intrinsics. SAFETY: only used on values of this file's types, whose
 /// existence proves AVX-512F support (see the module docs of `x86`); memory accesses are
@@ -113,6 +113,44 @@ fn active_in_bounds(s: Avx512, idx: I32x16, m: M16, len: usize, width: i32) -> M
         check_lanes(&iv, s.bitmask(m), len);
     }
     m
+}
+
+impl Avx512 {
+    /// True when `last ≥ 0` and every active lane has `idx ≤ last` as u32 (so `idx ≥ 0`).
+    #[inline(always)]
+    fn rows_fit(self, idx: I32x16, m: M16, last: i64) -> bool {
+        let over = M16(simd!(_mm512_cmpgt_epu32_mask(
+            idx.0,
+            _mm512_set1_epi32(last.clamp(0, i32::MAX as i64) as i32)
+        )));
+        last >= 0 && self.none(m & over)
+    }
+
+    /// The 4-byte words at `base + (idx + o)·SCALE` bytes for each offset `o` of `off`,
+    /// active lanes only (no closure: it would not inherit the entry's target features).
+    ///
+    /// # Safety
+    /// Every active lane's 4 bytes at each such address must lie inside one allocation.
+    #[inline(always)]
+    unsafe fn gather_words<const SCALE: i32, const N: usize>(
+        self,
+        base: *const u8,
+        idx: I32x16,
+        off: [i32; N],
+        m: M16,
+    ) -> [I32x16; N] {
+        let mut out = [self.splat_i(0); N];
+        for (w, o) in out.iter_mut().zip(off) {
+            // Bounds: the caller's contract.
+            *w = I32x16(simd!(_mm512_mask_i32gather_epi32::<SCALE>(
+                _mm512_setzero_si512(),
+                m.0,
+                (idx + self.splat_i(o)).0,
+                base.cast::<i32>()
+            )));
+        }
+        out
+    }
 }
 
 impl Simd for Avx512 {
@@ -424,34 +462,11 @@ impl Simd for Avx512 {
         off: [i32; N],
         m: M16,
     ) -> [I32x16; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_i_rows: negative offset"
-        );
-        let top = off.iter().copied().max().unwrap_or(0) as i64;
-        let hi = s.len().min(i32::MAX as usize) as i64 - 1 - top;
-        let bad = m & M16(simd!(_mm512_cmpgt_epu32_mask(
-            idx.0,
-            _mm512_set1_epi32(hi as i32)
-        )));
-        let mut out = [self.splat_i(0); N];
-        if hi < 0 || self.any(bad) {
-            for (w, o) in out.iter_mut().zip(off) {
-                *w = self.gather_i(s, idx + self.splat_i(o), m, self.splat_i(0));
-            }
-            return out;
+        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
+            return gather_rows_each(self, s, idx, off, m);
         }
-        for (w, o) in out.iter_mut().zip(off) {
-            // Bounds: every active lane reads s[idx + o] with 0 ≤ idx + o < len (checked
-            // just above).
-            *w = I32x16(simd!(_mm512_mask_i32gather_epi32::<4>(
-                _mm512_setzero_si512(),
-                m.0,
-                (idx + self.splat_i(o)).0,
-                s.as_ptr()
-            )));
-        }
-        out
+        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 1]`.
+        unsafe { self.gather_words::<4, N>(s.as_ptr().cast(), idx, off, m) }
     }
     // One unsigned compare bounds every row: `idx ≤ len − 4 − max(off)` as u32 also rules
     // out `idx < 0`, and each row's `idx + o` then lies in `[0, len − 4]`.
@@ -463,36 +478,11 @@ impl Simd for Avx512 {
         off: [i32; N],
         m: M16,
     ) -> [I32x16; N] {
-        assert!(
-            off.iter().all(|&o| o >= 0),
-            "gather_u8x4_rows: negative offset"
-        );
-        let top = off.iter().copied().max().unwrap_or(0) as i64;
-        let hi = s.len().min(i32::MAX as usize) as i64 - 4 - top;
-        let bad = m & M16(simd!(_mm512_cmpgt_epu32_mask(
-            idx.0,
-            _mm512_set1_epi32(hi as i32)
-        )));
-        if hi < 0 || self.any(bad) {
-            let mut out = [self.splat_i(0); N];
-            for (w, o) in out.iter_mut().zip(off) {
-                *w = self.gather_u8x4(s, idx + self.splat_i(o), m);
-            }
-            return out;
+        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
+            return gather_rows_each(self, s, idx, off, m);
         }
-        // No closure (it would not inherit the entry point's target features).
-        let mut out = [self.splat_i(0); N];
-        for (w, o) in out.iter_mut().zip(off) {
-            *w = // Bounds: every active lane reads s[idx + o .. idx + o + 4] with
-                // 0 ≤ idx + o ≤ len − 4 (checked just above).
-                I32x16(simd!(_mm512_mask_i32gather_epi32::<1>(
-                    _mm512_setzero_si512(),
-                    m.0,
-                    (idx + self.splat_i(o)).0,
-                    s.as_ptr().cast::<i32>()
-                )));
-        }
-        out
+        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 4]`.
+        unsafe { self.gather_words::<1, N>(s.as_ptr(), idx, off, m) }
     }
     #[inline(always)]
     fn gather_u8x4(self, s: &[u8], idx: I32x16, m: M16) -> I32x16 {

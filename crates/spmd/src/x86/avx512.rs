@@ -3,8 +3,8 @@
 
 use core::arch::x86_64::*;
 
-use super::{assignops, binops, check_lanes};
-use crate::{gather_rows_each, le_bytes4, rows_last_start, Isa, Kernel, Simd};
+use super::{assignops, binops, check_lanes, row_gathers};
+use crate::{le_bytes4, Isa, Kernel, Simd};
 
 /// Runs AVX-512F intrinsics. SAFETY: only used on values of this file's types, whose
 /// existence proves AVX-512F support (see the module docs of `x86`); memory accesses are
@@ -453,37 +453,7 @@ impl Simd for Avx512 {
             s.as_ptr()
         )))
     }
-    // One unsigned compare bounds every entry, as in `gather_u8x4_rows`.
-    #[inline(always)]
-    fn gather_i_rows<const N: usize>(
-        self,
-        s: &[i32],
-        idx: I32x16,
-        off: [i32; N],
-        m: M16,
-    ) -> [I32x16; N] {
-        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
-            return gather_rows_each(self, s, idx, off, m);
-        }
-        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 1]`.
-        unsafe { self.gather_words::<4, N>(s.as_ptr().cast(), idx, off, m) }
-    }
-    // One unsigned compare bounds every row: `idx ≤ len − 4 − max(off)` as u32 also rules
-    // out `idx < 0`, and each row's `idx + o` then lies in `[0, len − 4]`.
-    #[inline(always)]
-    fn gather_u8x4_rows<const N: usize>(
-        self,
-        s: &[u8],
-        idx: I32x16,
-        off: [i32; N],
-        m: M16,
-    ) -> [I32x16; N] {
-        if !self.rows_fit(idx, m, rows_last_start(s, &off)) {
-            return gather_rows_each(self, s, idx, off, m);
-        }
-        // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 4]`.
-        unsafe { self.gather_words::<1, N>(s.as_ptr(), idx, off, m) }
-    }
+    row_gathers!(I32x16, M16);
     #[inline(always)]
     fn gather_u8x4(self, s: &[u8], idx: I32x16, m: M16) -> I32x16 {
         // Fast path: one 4-byte gather per active lane, which needs `idx + 3 < len`; lanes

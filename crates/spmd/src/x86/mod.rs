@@ -53,6 +53,44 @@ macro_rules! assignops {
 }
 pub(crate) use assignops;
 
+/// The row gathers (`gather_i_rows`, `gather_u8x4_rows`) of a backend that has `rows_fit`
+/// and `gather_words`: the same code in AVX2 and AVX-512. One unsigned compare bounds every
+/// row (`idx ≤ len − span − max(off)` as u32 also rules out `idx < 0`); a packet that fails
+/// it takes the per-row path, which panics on a bad active lane.
+macro_rules! row_gathers {
+    ($i:ty, $m:ty) => {
+        #[inline(always)]
+        fn gather_i_rows<const N: usize>(
+            self,
+            s: &[i32],
+            idx: $i,
+            off: [i32; N],
+            m: $m,
+        ) -> [$i; N] {
+            if !self.rows_fit(idx, m, crate::rows_last_start(s, &off)) {
+                return crate::gather_rows_each(self, s, idx, off, m);
+            }
+            // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 1]`.
+            unsafe { self.gather_words::<4, N>(s.as_ptr().cast(), idx, off, m) }
+        }
+        #[inline(always)]
+        fn gather_u8x4_rows<const N: usize>(
+            self,
+            s: &[u8],
+            idx: $i,
+            off: [i32; N],
+            m: $m,
+        ) -> [$i; N] {
+            if !self.rows_fit(idx, m, crate::rows_last_start(s, &off)) {
+                return crate::gather_rows_each(self, s, idx, off, m);
+            }
+            // SAFETY: `rows_fit`: every active lane's `idx + o` lies in `[0, len − 4]`.
+            unsafe { self.gather_words::<1, N>(s.as_ptr(), idx, off, m) }
+        }
+    };
+}
+pub(crate) use row_gathers;
+
 /// Panics unless every active lane of a gather/store is inside a slice of `len` elements.
 /// `idx` and `active` are lane arrays; cheap enough for the lane-loop paths.
 #[inline(always)]

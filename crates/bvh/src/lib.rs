@@ -15,6 +15,7 @@
 //! ```
 
 #![warn(missing_docs)]
+mod beam;
 mod build;
 pub mod compact;
 mod geometry;
@@ -26,6 +27,7 @@ mod traverse;
 mod tree;
 mod wide;
 
+pub use beam::{Corners, Frusta, Origin};
 pub use build::{BuildOptions, CLUSTER_ABOVE, CLUSTER_UPTO, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{

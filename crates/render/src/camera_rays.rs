@@ -1,6 +1,6 @@
 //! Camera rays of a frame (paper §4.2): the one generator of primary rays of every modality.
 
-use bvh::RayPacket;
+use bvh::{Corners, Origin, RayPacket};
 use scene::{Camera, Projection};
 use spmd::{Simd, V3};
 
@@ -76,6 +76,48 @@ impl ViewRays {
             tmin: s.splat(0.0),
             tmax: s.splat(f32::INFINITY),
             active,
+        }
+    }
+
+    /// The rays through the corners of the pixel rectangle `[x0, x1] × [y0, y1]` (pixel
+    /// edges, so the rays through its pixel centres lie strictly inside), in f64.
+    pub(crate) fn corners(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> Corners {
+        let f = |a: [f32; 3]| [a[0] as f64, a[1] as f64, a[2] as f64];
+        let (org, dir0, du, dv) = (f(self.org), f(self.dir0), f(self.du), f(self.dv));
+        let at = |px: f64, py: f64| -> ([f64; 3], [f64; 3]) {
+            let step = [0, 1, 2].map(|a| du[a] * px + dv[a] * py);
+            if self.perspective {
+                (org, [0, 1, 2].map(|a| dir0[a] + step[a]))
+            } else {
+                ([0, 1, 2].map(|a| org[a] + step[a]), dir0)
+            }
+        };
+        let c = [at(x0, y0), at(x1, y0), at(x1, y1), at(x0, y1)];
+        Corners {
+            o: c.map(|r| r.0),
+            d: c.map(|r| r.1),
+        }
+    }
+
+    /// Where the camera rays start, for [`bvh::Frusta`].
+    pub(crate) fn origin(&self) -> Origin {
+        if self.perspective {
+            Origin::Point(self.org)
+        } else {
+            Origin::Plane {
+                org: self.org,
+                forward: self.dir0,
+            }
+        }
+    }
+
+    /// The (unnormalised) direction of the ray through frame point `(px, py)`.
+    pub(crate) fn direction(&self, px: f32, py: f32) -> [f32; 3] {
+        let step = [0, 1, 2].map(|a| self.du[a] * px + self.dv[a] * py);
+        if self.perspective {
+            [0, 1, 2].map(|a| self.dir0[a] + step[a])
+        } else {
+            self.dir0
         }
     }
 

@@ -232,12 +232,7 @@ impl Bvh {
                         far_t[b] = s.reduce_max(hits[b].t);
                     }
                 } else {
-                    let c = node.first as usize;
-                    let (near, far) = if fr.neg[node.axis()] {
-                        (c + 1, c)
-                    } else {
-                        (c, c + 1)
-                    };
+                    let (near, far) = node.near_far(&fr.neg);
                     stack[sp] = far as u32;
                     sp += 1;
                     idx = near;

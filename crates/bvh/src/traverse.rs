@@ -224,12 +224,7 @@ impl Bvh {
                         }
                     }
                 } else {
-                    let c = node.first as usize;
-                    let (near, far) = if neg[node.axis()] {
-                        (c + 1, c)
-                    } else {
-                        (c, c + 1)
-                    };
+                    let (near, far) = node.near_far(&neg);
                     stack[sp] = far as u32;
                     sp += 1;
                     idx = near;

@@ -50,6 +50,17 @@ impl Node {
     pub fn axis(&self) -> usize {
         (self.meta & 3) as usize
     }
+    /// An inner node's children as (near, far) for rays whose direction is negative along
+    /// the axes `neg` says: the child on the rays' side of the split first.
+    #[inline(always)]
+    pub fn near_far(&self, neg: &[bool; 3]) -> (usize, usize) {
+        let c = self.first as usize;
+        if neg[self.axis()] {
+            (c + 1, c)
+        } else {
+            (c, c + 1)
+        }
+    }
     /// The node's box.
     pub fn aabb(&self) -> Aabb {
         Aabb {

@@ -147,9 +147,6 @@ impl Bvh {
         rays: &[RayPacket<S>; N],
         stack: &mut [u32],
     ) -> [PacketHit<S>; N] {
-        let nodes = &self.nodes[..];
-        let records = &self.records[..];
-        let capped = self.capped;
         // (Loops, not `array::from_fn` closures: closures may not inherit target features.)
         let mut inv = [V3::splat(s, [0.0; 3]); N];
         let mut hits = [PacketHit {
@@ -162,14 +159,13 @@ impl Bvh {
             // Inactive lanes get t = −∞ so no box test passes for them.
             hits[j].t = s.select(rays[j].active, rays[j].tmax, s.splat(f32::NEG_INFINITY));
         }
-        let grow = s.splat(BOX_GROW);
         let mut first = N;
         for j in (0..N).rev() {
             if s.any(rays[j].active) {
                 first = j;
             }
         }
-        if first == N || nodes.is_empty() {
+        if first == N || self.nodes.is_empty() {
             return hits;
         }
         let lane = s.bitmask(rays[first].active).trailing_zeros() as usize;
@@ -179,8 +175,32 @@ impl Bvh {
             s.extract(d0.y, lane) < 0.0,
             s.extract(d0.z, lane) < 0.0,
         ];
+        self.walk_packets::<S, N, ANY>(s, rays, &inv, &mut hits, 0, &neg, stack);
+        hits
+    }
+
+    /// The loop of [`Bvh::query_packets`] over the subtree of node `root`, from the current
+    /// `hits` (`inv`: the rays' reciprocal directions; `neg`: the signs that order children).
+    /// Also finishes a block of [`Bvh::traverse_blocks`] below the node where it leaves the
+    /// block walk.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn walk_packets<S: Simd, const N: usize, const ANY: bool>(
+        &self,
+        s: S,
+        rays: &[RayPacket<S>; N],
+        inv: &[V3<S>; N],
+        hits: &mut [PacketHit<S>; N],
+        root: usize,
+        neg: &[bool; 3],
+        stack: &mut [u32],
+    ) {
+        let nodes = &self.nodes[..];
+        let records = &self.records[..];
+        let capped = self.capped;
+        let grow = s.splat(BOX_GROW);
         let mut sp = 0usize;
-        let mut idx = 0usize;
+        let mut idx = root;
         let mut masks = [s.splat_m(false); N];
         loop {
             let node = &nodes[idx];
@@ -220,11 +240,11 @@ impl Bvh {
                             open |= s.any(rays[j].active & !hits[j].hit_mask(s));
                         }
                         if !open {
-                            return hits;
+                            return;
                         }
                     }
                 } else {
-                    let (near, far) = node.near_far(&neg);
+                    let (near, far) = node.near_far(neg);
                     stack[sp] = far as u32;
                     sp += 1;
                     idx = near;
@@ -237,7 +257,6 @@ impl Bvh {
             sp -= 1;
             idx = stack[sp] as usize;
         }
-        hits
     }
 
     /// Origin for a secondary ray leaving the hit `h` of `ray`: the hit point offset along the

@@ -30,7 +30,9 @@ pub(super) fn tile<S: Simd>(s: S, k: &TileJob<'_>) -> Vec<u32> {
             // On AVX-512, one walk of the tree for the tile's 16 packets, nodes tested
             // against each packet's frustum (`render_tile_blocks`), is 1.1-1.6× faster
             // (ns740k / nanobowl at 1024², AMD EPYC Zen 4, 2026-12-07); on AVX2 (8×8-pixel
-            // groups) it was 5-10 % slower, so narrower backends keep one walk per packet.
+            // groups) it was 5-10 % slower, and with the hand-off to packets below (bvh's
+            // `handoff_blocks`) still 13-24 % slower close up, so narrower backends keep one
+            // walk per packet.
             _ => match k.model {
                 Some(sc) if S::LANES >= 16 => render_tile_blocks(s, k, sc, out),
                 _ if S::LANES == 1 => render_tile::<S, 4>(s, k, out),

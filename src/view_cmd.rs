@@ -33,13 +33,31 @@ pub struct ViewArgs {
     /// AO rays per hit when the `a` key switches ambient occlusion on (default: --ao, else 8).
     #[arg(help_heading = "Viewer", long, value_name = "N")]
     pub ao_key_samples: Option<u32>,
+    /// Threads that read and build time steps in the background (default: all cores). They
+    /// run at the lowest priority, so they use only what the window's frames leave.
+    #[arg(help_heading = "Viewer", long, value_name = "N")]
+    pub build_threads: Option<usize>,
     #[command(flatten)]
     pub look: LookArgs,
+}
+
+/// The loader's pool size: `--build-threads`, else every core (refused beyond 16 per core).
+fn build_threads(n: Option<usize>) -> Result<usize> {
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    let n = n.unwrap_or(cores);
+    if n == 0 || n > 16 * cores {
+        bail!(
+            "--build-threads {n}: use 1 to {} (16 per core on this machine)",
+            16 * cores
+        );
+    }
+    Ok(n)
 }
 
 /// Run `bnsview view`.
 pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
     args.look.init_threads(None)?;
+    let build_threads = build_threads(args.build_threads)?;
     let look = args.look.look(args.input.pbc)?;
     look.validate()?;
     if args.look.geometry.legend {
@@ -72,7 +90,7 @@ pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
         script,
         log: args.log.clone(),
         force: args.force,
-        build_threads: (rayon::current_num_threads() / 2).max(1),
+        build_threads,
         preview: !args.no_preview,
     };
     let report = viewer::run(cfg, source).context("bnsview view")?;
@@ -84,4 +102,24 @@ pub fn run(args: ViewArgs, isa: Isa) -> Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::build_threads;
+
+    #[test]
+    fn build_threads_default_to_every_core_and_refuse_zero_and_absurd_counts() {
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        assert_eq!(build_threads(None).unwrap(), cores);
+        assert_eq!(build_threads(Some(1)).unwrap(), 1);
+        assert_eq!(build_threads(Some(16 * cores)).unwrap(), 16 * cores);
+        for bad in [0, 16 * cores + 1, usize::MAX] {
+            let e = build_threads(Some(bad)).unwrap_err().to_string();
+            assert!(
+                e.contains("--build-threads") && e.contains("use 1 to"),
+                "{e}"
+            );
+        }
+    }
 }

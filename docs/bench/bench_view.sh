@@ -43,23 +43,33 @@ for sc in $SCENES; do
 done
 # PLAY=trajectory: play it while orbiting 300 frames at full resolution (each size), the
 # longest gap between two of those frames while a time step was being built, beside the
-# median render time.
+# median render time; then the same orbit without playing (no build), to compare each frame
+# with itself undisturbed. Also the time from start to the first frame (the first build).
 if [ -n "${PLAY:-}" ]; then
   { echo wait-still; echo "key space"; for i in $(seq 300); do echo "orbit 1 0"; echo "wait-frames 1"; done; echo wait-still; echo quit; } > $D/play.txt
+  grep -v "key space" $D/play.txt > $D/still.txt
   for s in $SIZES; do
     /usr/bin/time -f "peak RSS %M KB" $B view $PLAY --size ${s}x${s} --no-preview --script $D/play.txt --log $D/play.jsonl
-    python3 - $D/play.jsonl $s <<'PY'
+    $B view $PLAY --size ${s}x${s} --no-preview --script $D/still.txt --log $D/still.jsonl
+    python3 - $D/play.jsonl $D/still.jsonl $s <<'PY'
 import json, sys
 L = [json.loads(l) for l in open(sys.argv[1])]
+S = [json.loads(l) for l in open(sys.argv[2])]
 key = next(i for i, l in enumerate(L) if l.get('key') == 'PlayPause')
 p = [l for l in L[key:] if 'presented' in l][:300]      # the orbit's frames
+first = next(i for i, l in enumerate(S) if 'presented' in l)
+q = [l for l in S[first + 1:] if 'presented' in l][:300]  # the same orbit, nothing loading
 gaps = [b['t'] - a['t'] for a, b in zip(p, p[1:]) if b['loading']]
 rs = sorted(l['render_s'] for l in p)
-loads = [l for l in L if 'loaded' in l][1:]
+loads = [l for l in L if 'loaded' in l]
 gs = sorted(gaps)
 wait = max(b['t'] - a['t'] - b['render_s'] for a, b in zip(p, p[1:]) if b['loading'])
-print(f"{sys.argv[2]}²: {len(p)} orbit frames, {len(gaps)} during builds (median gap {gs[len(gs) // 2]:.3f} s); builds {', '.join('%.2f' % l['build_s'] for l in loads)} s; "
-      f"longest gap during a build {max(gaps):.3f} s, median render {rs[len(rs) // 2]:.3f} s, longest wait beyond a frame's own render {1e3 * wait:.1f} ms")
+still_gap = max(b['t'] - a['t'] for a, b in zip(q, q[1:]))
+ratio = sorted((b['t'] - a['t']) / c['render_s'] for a, b, c in zip(p, p[1:], q[1:]) if b['loading'])
+print(f"{sys.argv[3]}²: first frame after {loads[0]['t']:.2f} s (build {loads[0]['build_s']:.2f} s); {len(p)} orbit frames, {len(gaps)} during builds (median gap {gs[len(gs) // 2]:.3f} s); "
+      f"builds {', '.join('%.2f' % l['build_s'] for l in loads[1:])} s; longest gap during a build {max(gaps):.3f} s, median render {rs[len(rs) // 2]:.3f} s, "
+      f"longest wait beyond a frame's own render {1e3 * wait:.1f} ms; the same orbit without a build: longest gap {still_gap:.3f} s; "
+      f"gap during a build / the same frame's undisturbed render: median {ratio[len(ratio) // 2]:.2f}, largest {ratio[-1]:.2f}")
 PY
   done
 fi

@@ -271,3 +271,60 @@ fn bad_scripts_missing_displays_and_existing_files_are_clear_errors() {
     let (ok, _, err) = view(&["--legend", "--color", "q"]);
     assert!(!ok && err.contains("--legend"), "{err}");
 }
+
+#[test]
+fn the_first_step_shows_what_the_mode_needs_first_and_the_volume_follows_behind() {
+    let d = scratch("view-upgrade");
+    let script = d.join("keys.txt");
+    let log = d.join("log.jsonl");
+    std::fs::write(
+        &script,
+        "wait-still\nkey 3\nwait-frames 1\nwait-still\nquit\n",
+    )
+    .unwrap();
+    let (ok, _, err) = view(&[
+        "--scene",
+        "nanobowl",
+        "--size",
+        "48x48",
+        "--mode",
+        "bs",
+        "--script",
+        script.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let lines = log_lines(&log);
+    let loaded: Vec<(usize, &str)> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| field(l, "loaded").is_some())
+        .map(|(i, l)| (i, field(l, "upgrade").unwrap_or("missing")))
+        .collect();
+    // Two builds of time step 0: balls and sticks (what --mode bs needs), then the model and
+    // the volume, asked for once the first is on screen; the first frame comes in between.
+    assert_eq!(
+        loaded.iter().map(|l| l.1).collect::<Vec<_>>(),
+        ["false", "true"],
+        "{lines:?}"
+    );
+    let first_frame = lines.iter().position(|l| field(l, "presented").is_some());
+    assert!(
+        first_frame.is_some_and(|f| loaded[0].0 < f && f < loaded[1].0),
+        "{lines:?}"
+    );
+    // The vol+bs key then needs no build: no third scene, and its frames are vol+bs.
+    let key = lines
+        .iter()
+        .position(|l| field(l, "key").is_some())
+        .unwrap();
+    assert!(key > loaded[1].0, "{lines:?}");
+    assert!(
+        lines[key..]
+            .iter()
+            .filter(|l| field(l, "presented").is_some())
+            .all(|l| field(l, "mode") == Some("vol+bs")),
+        "{lines:?}"
+    );
+}

@@ -6,14 +6,16 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use render::{draw_text, rgba, FrameInputs, Framebuffer, RenderSettings};
-use scene::{Camera, ColorBy, Scene, SceneSettings, Sphere};
+use render::{FrameInputs, Framebuffer, RenderSettings};
+use scene::{Camera, Scene, SceneSettings, Sphere};
 use spmd::Isa;
 
 use crate::error::ViewError;
+use crate::fit::{fit, fix_ranges, Fit, Ranges};
 use crate::keys::{help_lines, toggle, Action, Toggles};
 use crate::loader::{Answer, FrameSource, Loader, Request};
 use crate::nav::Navigation;
+use crate::overlay::{draw_lines, loading_lines, text_frame};
 use crate::refine::Refiner;
 use crate::script::Command;
 use crate::window::{Input, Window};
@@ -66,10 +68,6 @@ struct Shown {
     frame: usize,
 }
 
-/// The column colour range and the density at the top of the transfer function of the first
-/// time step shown.
-type Ranges = (Option<(f32, f32)>, Option<f32>);
-
 /// Everything the loop keeps.
 struct App {
     cfg: ViewConfig,
@@ -85,8 +83,12 @@ struct App {
     shown: Option<Shown>,
     frames: Option<usize>,
     playing: bool,
-    /// The newest request: (id, frame, whether it is the first frame's superset scene).
-    waiting: Option<(u64, usize, bool)>,
+    /// The newest request: (id, frame).
+    waiting: Option<(u64, usize)>,
+    /// The first time step's scene with the model and the volume, asked for once that step is
+    /// on screen (so that mode keys need no build): its settings until asked for, then the
+    /// request's id.
+    upgrade: Upgrade,
     next_id: u64,
     /// Colour and density ranges of the first frame, fixed for the others.
     ranges: Option<Ranges>,
@@ -94,11 +96,26 @@ struct App {
     message: Option<(String, Instant)>,
     presented: u64,
     last_present: Instant,
+    /// The input's name, for the screen shown while the first scene is made.
+    name: String,
+    /// When that screen was last drawn.
+    loading_drawn: Option<Instant>,
     fps: f64,
     start: Instant,
     log: Option<std::io::BufWriter<std::fs::File>>,
     screenshots: Vec<PathBuf>,
     shot_count: u32,
+}
+
+/// The first time step's scene with the model and the volume (see `App::upgrade`).
+#[derive(Clone, Debug, PartialEq)]
+enum Upgrade {
+    /// Not wanted (the first scene has both, or cannot), or already arrived.
+    None,
+    /// To ask for once the first scene is on screen.
+    Wanted(Box<SceneSettings>),
+    /// Asked for: the request's id.
+    Asked(u64),
 }
 
 /// Opens the window over `source` and runs until the window closes, `q`, or the script's
@@ -138,12 +155,15 @@ pub fn run(cfg: ViewConfig, source: FrameSource) -> Result<ViewReport, ViewError
         frames: None,
         playing: false,
         waiting: None,
+        upgrade: Upgrade::None,
         next_id: 0,
         ranges: None,
         help: false,
         message: None,
         presented: 0,
         last_present: Instant::now(),
+        name: name.clone(),
+        loading_drawn: None,
         fps: 0.0,
         start: Instant::now(),
         log,
@@ -152,12 +172,14 @@ pub fn run(cfg: ViewConfig, source: FrameSource) -> Result<ViewReport, ViewError
         cfg,
     };
     app.refiner.set_kind(app.toggles.flags());
-    // The first scene holds both the model and the volume when it can, so that switching
-    // modes needs no build.
+    // The first time step with what the mode needs, on screen as soon as it can be; then the
+    // same step with the model and the volume behind it, so that switching modes needs no build.
     let first = app.cfg.first_frame;
     let superset = app.superset(&scene_settings);
-    let is_superset = superset != scene_settings;
-    app.request(first, superset, is_superset);
+    if superset != scene_settings {
+        app.upgrade = Upgrade::Wanted(Box::new(superset));
+    }
+    app.request(first, scene_settings);
     let result = app.run_loop();
     if let Some(l) = app.log.as_mut() {
         let _ = l.flush();
@@ -181,9 +203,9 @@ impl App {
         }
     }
 
-    fn request(&mut self, frame: usize, settings: SceneSettings, superset: bool) {
+    fn request(&mut self, frame: usize, settings: SceneSettings) {
         self.next_id += 1;
-        self.waiting = Some((self.next_id, frame, superset));
+        self.waiting = Some((self.next_id, frame));
         self.loader.request(Request {
             id: self.next_id,
             frame,
@@ -377,7 +399,7 @@ impl App {
                 let frame = shown.frame;
                 self.pending = Some(t);
                 self.say(format!("building the scene for {}…", t.flags()));
-                self.request(frame, need, false);
+                self.request(frame, need);
                 return;
             }
         }
@@ -396,7 +418,7 @@ impl App {
         }
         let t = self.pending.unwrap_or(self.toggles);
         match self.needs(&t) {
-            Ok((s, _)) => self.request(k, s, false),
+            Ok((s, _)) => self.request(k, s),
             Err(e) => self.say(e),
         }
     }
@@ -424,7 +446,13 @@ impl App {
             match a {
                 Answer::Frames(Ok(n)) => self.frames = Some(n),
                 Answer::Frames(Err(e)) => self.say(format!("counting time steps: {e}")),
-                Answer::Skipped { .. } => {}
+                Answer::Skipped { id } => {
+                    // A newer request came first (a mode key, another step): it builds what is
+                    // needed, and a mode key later builds the volume if it is missing.
+                    if self.upgrade == Upgrade::Asked(id) {
+                        self.upgrade = Upgrade::None;
+                    }
+                }
                 Answer::Built {
                     id,
                     frame,
@@ -432,7 +460,22 @@ impl App {
                     read_s,
                     build_s,
                 } => {
-                    let Some((want, _, superset)) = self.waiting else {
+                    if self.upgrade == Upgrade::Asked(id) {
+                        self.upgrade = Upgrade::None;
+                        // Swapped in only over the step it was made for, and only when
+                        // nothing newer is on its way.
+                        let here = self.shown.as_ref().is_some_and(|s| s.frame == frame);
+                        match scene {
+                            Ok(s) if here && self.waiting.is_none() => {
+                                self.swap_in(s, frame, read_s, build_s, true)?
+                            }
+                            Ok(_) => {}
+                            Err(e) => self
+                                .say(format!("{e}: the volume is built when a mode key needs it")),
+                        }
+                        continue;
+                    }
+                    let Some((want, _)) = self.waiting else {
                         continue;
                     };
                     if id != want {
@@ -440,17 +483,7 @@ impl App {
                     }
                     self.waiting = None;
                     match scene {
-                        Ok(s) => self.swap_in(s, frame, read_s, build_s)?,
-                        Err(e) if self.shown.is_none() && superset => {
-                            // The model and the volume together did not fit: only what the
-                            // toggles need.
-                            self.say(format!(
-                                "{e}; building what --mode {} needs only",
-                                self.toggles.mode.name()
-                            ));
-                            let exact = self.needs(&self.toggles).map_err(ViewError::Settings)?.0;
-                            self.request(frame, exact, false);
-                        }
+                        Ok(s) => self.swap_in(s, frame, read_s, build_s, false)?,
                         Err(e) if self.shown.is_none() => return Err(ViewError::Scene(e)),
                         Err(e) => {
                             self.playing = false;
@@ -470,12 +503,14 @@ impl App {
         frame: usize,
         read_s: f64,
         build_s: f64,
+        upgrade: bool,
     ) -> Result<(), ViewError> {
-        if self.ranges.is_none() {
-            let color = s.model.as_ref().and_then(|m| m.color_range);
-            let density = s.volume.as_ref().map(|d| d.tf_max);
-            self.ranges = Some((color, density));
-        }
+        // The ranges of the first step shown (the density range: of the first one shown with
+        // a volume), fixed for the others.
+        let color = s.model.as_ref().and_then(|m| m.color_range);
+        let density = s.volume.as_ref().map(|d| d.tf_max);
+        let r = self.ranges.get_or_insert((color, density));
+        r.1 = r.1.or(density);
         if let Some(r) = self.ranges {
             fix_ranges(&mut s.settings, r);
         }
@@ -485,11 +520,23 @@ impl App {
             self.home = Some(self.nav);
         }
         self.log(format!(
-            "\"loaded\":{frame},\"read_s\":{read_s:.6},\"build_s\":{build_s:.6}"
+            "\"loaded\":{frame},\"read_s\":{read_s:.6},\"build_s\":{build_s:.6},\"upgrade\":{upgrade}"
         ));
         if let Some(old) = self.shown.replace(Shown { scene: s, frame }) {
             // Freeing a large scene takes milliseconds: not on the window's thread.
             let _ = std::thread::Builder::new().spawn(move || drop(old));
+        }
+        if let Upgrade::Wanted(mut sup) = std::mem::replace(&mut self.upgrade, Upgrade::None) {
+            if let Some(r) = self.ranges {
+                fix_ranges(&mut sup, r);
+            }
+            self.next_id += 1;
+            self.upgrade = Upgrade::Asked(self.next_id);
+            self.loader.request(Request {
+                id: self.next_id,
+                frame,
+                settings: *sup,
+            });
         }
         if let Some(t) = self.pending.take() {
             self.set_toggles(t);
@@ -504,6 +551,7 @@ impl App {
     /// One refinement step and present; `false` when there was nothing to draw.
     fn draw(&mut self, moved: bool) -> Result<bool, ViewError> {
         let Some(shown) = &self.shown else {
+            self.draw_loading()?;
             return Ok(false);
         };
         let (camera, m, isa) = (self.nav.camera(), self.toggles.mode, self.cfg.isa);
@@ -544,6 +592,27 @@ impl App {
         Ok(true)
     }
 
+    /// While the first scene is made: a black frame that says so, redrawn every quarter
+    /// second with the time taken (and the title), so the window is not blank meanwhile.
+    fn draw_loading(&mut self) -> Result<(), ViewError> {
+        if self
+            .loading_drawn
+            .is_some_and(|t| t.elapsed() < Duration::from_millis(250))
+        {
+            return Ok(());
+        }
+        self.loading_drawn = Some(Instant::now());
+        let frame = self.waiting.map_or(self.cfg.first_frame, |w| w.1);
+        let secs = self.start.elapsed().as_secs_f64();
+        let mut lines = loading_lines(&self.name, frame, secs);
+        lines.extend(self.message.iter().map(|(m, _)| m.clone()));
+        let (w, h) = self.cfg.size;
+        self.win.present(&text_frame(w, h, &lines).pixels)?;
+        self.win
+            .set_title(&format!("bnsview — {} — loading", self.name));
+        Ok(())
+    }
+
     fn title(&self, frame: usize, scale: u32, samples: u32) -> String {
         let n = self.frames.map_or("?".into(), |n| n.to_string());
         let quality = if scale > 1 {
@@ -581,30 +650,7 @@ impl App {
                 self.message = None;
             }
         }
-        if lines.is_empty() {
-            return;
-        }
-        let scale = if fb.width >= 1000 { 2 } else { 1 };
-        let line_h = 10 * scale;
-        let box_h = (lines.len() as u32 * line_h + 8).min(fb.height);
-        let bg = rgba(0, 0, 0, 255);
-        for y in 0..box_h {
-            let row = (y * fb.width) as usize;
-            for p in &mut fb.pixels[row..row + fb.width as usize] {
-                // Darken to a quarter, so the picture shows through.
-                *p = (*p >> 2 & 0x003f_3f3f) | bg;
-            }
-        }
-        for (i, l) in lines.iter().enumerate() {
-            draw_text(
-                fb,
-                l,
-                4,
-                4 + i as u32 * line_h,
-                scale,
-                rgba(255, 255, 255, 255),
-            );
-        }
+        draw_lines(fb, &lines);
     }
 
     /// Writes the fully refined frame (what `bnsview render` makes of this view) to `path`,
@@ -672,129 +718,4 @@ fn with_inputs<R>(
         volume: volume.as_ref(),
         camera,
     })
-}
-
-/// How a built scene serves the settings `need`.
-enum Fit {
-    /// As it is.
-    Serves,
-    /// With this transfer function instead of its own.
-    NewTf(volume::TransferFunction),
-    /// Not: it must be rebuilt.
-    Rebuild,
-}
-
-/// Whether `scene` can show what `need` asks for (the wide BVH is built on demand, so it does
-/// not count; a scene may hold more than asked for).
-fn fit(scene: &Scene, need: &SceneSettings) -> Fit {
-    let have = &scene.settings;
-    let model_ok = match (&need.model, &have.model) {
-        (None, _) => true,
-        (Some(n), Some(h)) => {
-            scene::ModelSettings {
-                wide_bvh: h.wide_bvh,
-                ..n.clone()
-            } == *h
-        }
-        (Some(_), None) => false,
-    };
-    if !model_ok || need.bonds != have.bonds {
-        return Fit::Rebuild;
-    }
-    match (&need.volume, &have.volume) {
-        (None, _) => Fit::Serves,
-        (Some(n), Some(h)) if n == h => Fit::Serves,
-        (Some(n), Some(h))
-            if scene::VolumeSettings {
-                tf: h.tf.clone(),
-                ..n.clone()
-            } == *h =>
-        {
-            Fit::NewTf(n.tf.clone())
-        }
-        _ => Fit::Rebuild,
-    }
-}
-
-/// Fixes the colour and density ranges left open in `s` to the first frame's.
-fn fix_ranges(s: &mut SceneSettings, (color, density): Ranges) {
-    if let Some(ms) = s.model.as_mut() {
-        if let ColorBy::Column { range, .. } = &mut ms.color {
-            *range = range.or(color);
-        }
-    }
-    if let Some(vs) = s.volume.as_mut() {
-        vs.density_max = vs.density_max.or(density);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use molecule::scenes::{try_generate, SceneName};
-    use scene::{ModelSettings, VolumeSettings};
-
-    #[test]
-    fn a_scene_serves_what_it_holds_and_only_that() {
-        let m = try_generate(SceneName::Nanobowl, Some(400), 1).unwrap();
-        let both = SceneSettings {
-            volume: Some(VolumeSettings {
-                voxels_per_angstrom: 1.0,
-                ..VolumeSettings::default()
-            }),
-            ..SceneSettings::default()
-        };
-        let isa = Isa::detect();
-        let mut sc = Scene::build(isa, &m, &both).unwrap();
-        let bs = SceneSettings {
-            volume: None,
-            ..both.clone()
-        };
-        let volume = SceneSettings {
-            model: None,
-            ..both.clone()
-        };
-        assert!(matches!(fit(&sc, &both), Fit::Serves));
-        assert!(matches!(fit(&sc, &bs), Fit::Serves));
-        assert!(matches!(fit(&sc, &volume), Fit::Serves));
-        // The wide BVH is built on demand: it does not call for a rebuild.
-        let wide = SceneSettings {
-            model: Some(ModelSettings {
-                wide_bvh: true,
-                ..ModelSettings::default()
-            }),
-            ..bs.clone()
-        };
-        assert!(matches!(fit(&sc, &wide), Fit::Serves));
-        // Other balls do.
-        let fat = SceneSettings {
-            model: Some(ModelSettings {
-                radius_scale: 0.8,
-                ..ModelSettings::default()
-            }),
-            ..bs.clone()
-        };
-        assert!(matches!(fit(&sc, &fat), Fit::Rebuild));
-        // Another opacity re-classifies the transfer function, as a build with it would.
-        let mut opaque = both.clone();
-        let vs = opaque.volume.as_mut().unwrap();
-        vs.tf = vs.tf.clone().scale_opacity(2.0);
-        let Fit::NewTf(tf) = fit(&sc, &opaque) else {
-            panic!("expected a new transfer function");
-        };
-        assert!(sc.set_transfer_function(&tf));
-        let built = Scene::build(isa, &m, &opaque).unwrap();
-        let (a, b) = (
-            &sc.volume.as_ref().unwrap().tf,
-            &built.volume.as_ref().unwrap().tf,
-        );
-        assert_eq!(
-            (&a.preint, &a.post, &a.range_max),
-            (&b.preint, &b.post, &b.range_max)
-        );
-        assert!(matches!(fit(&sc, &opaque), Fit::Serves));
-        // A scene without a volume serves no volume.
-        let only_bs = Scene::build(isa, &m, &bs).unwrap();
-        assert!(matches!(fit(&only_bs, &volume), Fit::Rebuild));
-    }
 }

@@ -9,9 +9,11 @@
 
 mod app;
 mod error;
+mod fit;
 mod keys;
 mod loader;
 mod nav;
+mod overlay;
 mod refine;
 pub mod script;
 mod window;

@@ -462,11 +462,15 @@ impl App {
                 } => {
                     if self.upgrade == Upgrade::Asked(id) {
                         self.upgrade = Upgrade::None;
-                        // Swapped in only over the step it was made for, and only when
-                        // nothing newer is on its way.
+                        // Swapped in only over the step it was made for, and only when no
+                        // other step is on its way. A request for this step (a key pressed
+                        // before the upgrade came) is dropped: swapping in applies the key,
+                        // and asks again only if the upgrade does not serve it.
                         let here = self.shown.as_ref().is_some_and(|s| s.frame == frame);
+                        let this_step = self.waiting.is_none_or(|w| w.1 == frame);
                         match scene {
-                            Ok(s) if here && self.waiting.is_none() => {
+                            Ok(s) if here && this_step => {
+                                self.waiting = None;
                                 self.swap_in(s, frame, read_s, build_s, true)?
                             }
                             Ok(_) => {}

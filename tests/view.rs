@@ -275,56 +275,76 @@ fn bad_scripts_missing_displays_and_existing_files_are_clear_errors() {
 #[test]
 fn the_first_step_shows_what_the_mode_needs_first_and_the_volume_follows_behind() {
     let d = scratch("view-upgrade");
-    let script = d.join("keys.txt");
-    let log = d.join("log.jsonl");
-    std::fs::write(
-        &script,
-        "wait-still\nkey 3\nwait-frames 1\nwait-still\nquit\n",
-    )
-    .unwrap();
-    let (ok, _, err) = view(&[
-        "--scene",
-        "nanobowl",
-        "--size",
-        "48x48",
-        "--mode",
-        "bs",
-        "--script",
-        script.to_str().unwrap(),
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    // A 20k-atom trajectory: its volume takes far longer to build than a 48×48 frame.
+    let traj = d.join("traj.xyz");
+    let mut c = bnsview();
+    c.args(["generate", "ns90k", "--atoms", "20000", "-o"])
+        .arg(&traj);
+    let (ok, _, err) = run(&mut c);
     assert!(ok, "{err}");
-    let lines = log_lines(&log);
-    let loaded: Vec<(usize, &str)> = lines
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| field(l, "loaded").is_some())
-        .map(|(i, l)| (i, field(l, "upgrade").unwrap_or("missing")))
-        .collect();
-    // Two builds of time step 0: balls and sticks (what --mode bs needs), then the model and
-    // the volume, asked for once the first is on screen; the first frame comes in between.
-    assert_eq!(
-        loaded.iter().map(|l| l.1).collect::<Vec<_>>(),
-        ["false", "true"],
-        "{lines:?}"
-    );
-    let first_frame = lines.iter().position(|l| field(l, "presented").is_some());
-    assert!(
-        first_frame.is_some_and(|f| loaded[0].0 < f && f < loaded[1].0),
-        "{lines:?}"
-    );
-    // The vol+bs key then needs no build: no third scene, and its frames are vol+bs.
-    let key = lines
-        .iter()
-        .position(|l| field(l, "key").is_some())
+    // The vol+bs key once everything is built, and right after the first frame (while the
+    // volume is still on its way: the key then waits for it rather than asking for more).
+    for (name, start) in [("still", "wait-still"), ("early", "wait-frames 1")] {
+        let script = d.join(format!("{name}.txt"));
+        let log = d.join(format!("{name}.jsonl"));
+        std::fs::write(
+            &script,
+            format!("{start}\nkey 3\nwait-frames 1\nwait-still\nquit\n"),
+        )
         .unwrap();
-    assert!(key > loaded[1].0, "{lines:?}");
-    assert!(
-        lines[key..]
+        let (ok, _, err) = view(&[
+            traj.to_str().unwrap(),
+            "--size",
+            "48x48",
+            "--mode",
+            "bs",
+            "--script",
+            script.to_str().unwrap(),
+            "--log",
+            log.to_str().unwrap(),
+        ]);
+        assert!(ok, "{name}: {err}");
+        let lines = log_lines(&log);
+        let loaded: Vec<(usize, &str)> = lines
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| field(l, "loaded").is_some())
+            .map(|(i, l)| (i, field(l, "upgrade").unwrap_or("missing")))
+            .collect();
+        // Two builds of time step 0: balls and sticks (what --mode bs needs), then the model
+        // and the volume, asked for once the first is on screen; the first frame in between.
+        // The key needs no third.
+        assert_eq!(
+            loaded.iter().map(|l| l.1).collect::<Vec<_>>(),
+            ["false", "true"],
+            "{name}: {lines:?}"
+        );
+        let first_frame = lines.iter().position(|l| field(l, "presented").is_some());
+        assert!(
+            first_frame.is_some_and(|f| loaded[0].0 < f && f < loaded[1].0),
+            "{name}: {lines:?}"
+        );
+        // And no build was thrown away.
+        assert!(
+            lines.iter().all(|l| field(l, "discarded").is_none()),
+            "{name}: {lines:?}"
+        );
+        // After the key, frames are vol+bs once the volume is in, never a scene without it.
+        let key = lines
+            .iter()
+            .position(|l| field(l, "key").is_some())
+            .unwrap();
+        let after: Vec<&str> = lines[key..]
             .iter()
             .filter(|l| field(l, "presented").is_some())
-            .all(|l| field(l, "mode") == Some("vol+bs")),
-        "{lines:?}"
-    );
+            .map(|l| field(l, "mode").unwrap())
+            .collect();
+        assert!(after.last() == Some(&"vol+bs"), "{name}: {lines:?}");
+        if name == "still" {
+            assert!(
+                key > loaded[1].0 && after.iter().all(|m| *m == "vol+bs"),
+                "{lines:?}"
+            );
+        }
+    }
 }

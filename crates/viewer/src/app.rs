@@ -11,7 +11,7 @@ use scene::{Camera, Scene, SceneSettings, Sphere};
 use spmd::Isa;
 
 use crate::error::ViewError;
-use crate::fit::{fit, fix_ranges, Fit, Ranges};
+use crate::fit::{fit, fit_settings, fix_ranges, Fit, Ranges};
 use crate::keys::{help_lines, toggle, Action, Toggles};
 use crate::loader::{Answer, FrameSource, Loader, Request};
 use crate::nav::Navigation;
@@ -114,8 +114,15 @@ enum Upgrade {
     None,
     /// To ask for once the first scene is on screen.
     Wanted(Box<SceneSettings>),
-    /// Asked for: the request's id.
-    Asked(u64),
+    /// Asked for: the request's id, its time step and settings.
+    Asked(u64, usize, Box<SceneSettings>),
+}
+
+impl Upgrade {
+    /// Whether `id` is the upgrade's request.
+    fn is(&self, id: u64) -> bool {
+        matches!(self, Upgrade::Asked(a, ..) if *a == id)
+    }
 }
 
 /// Opens the window over `source` and runs until the window closes, `q`, or the script's
@@ -398,6 +405,14 @@ impl App {
             _ => {
                 let frame = shown.frame;
                 self.pending = Some(t);
+                // The upgrade on its way serves these toggles: swapping it in applies them.
+                if let Upgrade::Asked(_, f, sup) = &self.upgrade {
+                    let serves = !matches!(fit_settings(sup, &need), Fit::Rebuild);
+                    if serves && *f == frame && self.waiting.is_none() {
+                        self.say(format!("building the volume for {}…", t.flags()));
+                        return;
+                    }
+                }
                 self.say(format!("building the scene for {}…", t.flags()));
                 self.request(frame, need);
                 return;
@@ -407,6 +422,18 @@ impl App {
         self.toggles = t;
         self.settings = rs;
         self.refiner.invalidate();
+    }
+
+    /// The upgrade will not be swapped in: toggles that waited for it ask for their own scene.
+    fn upgrade_lost(&mut self) {
+        let (Some(t), None, Some(shown)) = (self.pending, self.waiting, &self.shown) else {
+            return;
+        };
+        let frame = shown.frame;
+        match self.needs(&t) {
+            Ok((need, _)) => self.request(frame, need),
+            Err(e) => self.say(e),
+        }
     }
 
     fn go_to(&mut self, k: usize) {
@@ -449,7 +476,7 @@ impl App {
                 Answer::Skipped { id } => {
                     // A newer request came first (a mode key, another step): it builds what is
                     // needed, and a mode key later builds the volume if it is missing.
-                    if self.upgrade == Upgrade::Asked(id) {
+                    if self.upgrade.is(id) {
                         self.upgrade = Upgrade::None;
                     }
                 }
@@ -460,7 +487,7 @@ impl App {
                     read_s,
                     build_s,
                 } => {
-                    if self.upgrade == Upgrade::Asked(id) {
+                    if self.upgrade.is(id) {
                         self.upgrade = Upgrade::None;
                         // Swapped in only over the step it was made for, and only when no
                         // other step is on its way. A request for this step (a key pressed
@@ -473,16 +500,20 @@ impl App {
                                 self.waiting = None;
                                 self.swap_in(s, frame, read_s, build_s, true)?
                             }
-                            Ok(_) => {}
-                            Err(e) => self
-                                .say(format!("{e}: the volume is built when a mode key needs it")),
+                            Ok(_) => {
+                                self.log(format!("\"discarded\":{frame},\"build_s\":{build_s:.6}"));
+                                self.upgrade_lost();
+                            }
+                            Err(e) => {
+                                self.say(format!("{e}: the volume is built when a key needs it"));
+                                self.upgrade_lost();
+                            }
                         }
                         continue;
                     }
-                    let Some((want, _)) = self.waiting else {
-                        continue;
-                    };
-                    if id != want {
+                    if self.waiting.is_none_or(|w| w.0 != id) {
+                        // Superseded while it was built: logged, so waste shows.
+                        self.log(format!("\"discarded\":{frame},\"build_s\":{build_s:.6}"));
                         continue;
                     }
                     self.waiting = None;
@@ -535,12 +566,12 @@ impl App {
                 fix_ranges(&mut sup, r);
             }
             self.next_id += 1;
-            self.upgrade = Upgrade::Asked(self.next_id);
             self.loader.request(Request {
                 id: self.next_id,
                 frame,
-                settings: *sup,
+                settings: (*sup).clone(),
             });
+            self.upgrade = Upgrade::Asked(self.next_id, frame, sup);
         }
         if let Some(t) = self.pending.take() {
             self.set_toggles(t);

@@ -21,7 +21,11 @@ pub(crate) enum Fit {
 /// Whether `scene` can show what `need` asks for (the wide BVH is built on demand, so it does
 /// not count; a scene may hold more than asked for).
 pub(crate) fn fit(scene: &Scene, need: &SceneSettings) -> Fit {
-    let have = &scene.settings;
+    fit_settings(&scene.settings, need)
+}
+
+/// How a scene built with the settings `have` serves `need` (see [`fit`]).
+pub(crate) fn fit_settings(have: &SceneSettings, need: &SceneSettings) -> Fit {
     let model_ok = match (&need.model, &have.model) {
         (None, _) => true,
         (Some(n), Some(h)) => {

@@ -141,6 +141,33 @@ fn field<'a>(l: &'a [(String, String)], k: &str) -> Option<&'a str> {
     l.iter().find(|(a, _)| a == k).map(|(_, v)| v.as_str())
 }
 
+/// `bnsview view INPUT --size 48x48 FLAGS` driven by `script` (written to `DIR/NAME.txt`) with
+/// a `--log` (`DIR/NAME.jsonl`); must succeed. Its stdout and log lines.
+fn view_logged(
+    input: &Path,
+    flags: &[&str],
+    script: &str,
+    dir: &Path,
+    name: &str,
+) -> (String, Vec<Vec<(String, String)>>) {
+    let (path, log) = (
+        dir.join(format!("{name}.txt")),
+        dir.join(format!("{name}.jsonl")),
+    );
+    std::fs::write(&path, script).unwrap();
+    let mut args = vec![input.to_str().unwrap(), "--size", "48x48"];
+    args.extend_from_slice(flags);
+    args.extend([
+        "--script",
+        path.to_str().unwrap(),
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    let (ok, out, err) = view(&args);
+    assert!(ok, "{name}: {err}");
+    (out, log_lines(&log))
+}
+
 #[test]
 fn playback_shows_every_time_step_in_order_while_the_next_is_built_behind() {
     let d = scratch("view-play");
@@ -153,7 +180,6 @@ fn playback_shows_every_time_step_in_order_while_the_next_is_built_behind() {
     .arg(&traj);
     let (ok, _, err) = run(&mut c);
     assert!(ok, "{err}");
-    let script = d.join("play.txt");
     let shot = |k: usize| d.join(format!("step{k}.png"));
     // Play while orbiting a little every frame (so frames keep coming during builds), then
     // a screenshot of each time step, stepped to with the keys.
@@ -167,19 +193,7 @@ fn playback_shows_every_time_step_in_order_while_the_next_is_built_behind() {
         shot(1).display(),
         shot(0).display()
     );
-    std::fs::write(&script, text).unwrap();
-    let log = d.join("log.jsonl");
-    let (ok, out, err) = view(&[
-        traj.to_str().unwrap(),
-        "--size",
-        "48x48",
-        "--script",
-        script.to_str().unwrap(),
-        "--log",
-        log.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let lines = log_lines(&log);
+    let (out, lines) = view_logged(&traj, &[], &text, &d, "play");
     let presented: Vec<(usize, bool)> = lines
         .iter()
         .filter(|l| field(l, "presented").is_some())
@@ -285,26 +299,8 @@ fn the_first_step_shows_what_the_mode_needs_first_and_the_volume_follows_behind(
     // The vol+bs key once everything is built, and right after the first frame (while the
     // volume is still on its way: the key then waits for it rather than asking for more).
     for (name, start) in [("still", "wait-still"), ("early", "wait-frames 1")] {
-        let script = d.join(format!("{name}.txt"));
-        let log = d.join(format!("{name}.jsonl"));
-        std::fs::write(
-            &script,
-            format!("{start}\nkey 3\nwait-frames 1\nwait-still\nquit\n"),
-        )
-        .unwrap();
-        let (ok, _, err) = view(&[
-            traj.to_str().unwrap(),
-            "--size",
-            "48x48",
-            "--mode",
-            "bs",
-            "--script",
-            script.to_str().unwrap(),
-            "--log",
-            log.to_str().unwrap(),
-        ]);
-        assert!(ok, "{name}: {err}");
-        let lines = log_lines(&log);
+        let script = format!("{start}\nkey 3\nwait-frames 1\nwait-still\nquit\n");
+        let (_, lines) = view_logged(&traj, &["--mode", "bs"], &script, &d, name);
         let loaded: Vec<(usize, &str)> = lines
             .iter()
             .enumerate()

@@ -73,10 +73,7 @@ pub fn follow_stages<T>(title: &str, work: impl FnOnce(&Progress) -> T) -> T {
             _ => pb.set_length(units.max(1)),
         }
     };
-    let progress = Progress {
-        stage: &stage,
-        done: done.clone(),
-    };
+    let progress = Progress::new(&stage, done.clone());
     let out = follow_bytes(&pb, &done, title, || work(&progress));
     pb.finish_and_clear();
     out

@@ -5,7 +5,7 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
 
@@ -168,18 +168,24 @@ fn view_logged(
     (out, log_lines(&log))
 }
 
+/// `traj.xyz` in `d`: `frames` time steps of a 20k-atom ns90k.
+fn ns90k_steps(d: &Path, frames: usize) -> PathBuf {
+    let traj = d.join("traj.xyz");
+    let mut c = bnsview();
+    c.args(["generate", "ns90k", "--atoms", "20000", "--frames"])
+        .arg(frames.to_string())
+        .arg("-o")
+        .arg(&traj);
+    let (ok, _, err) = run(&mut c);
+    assert!(ok, "{err}");
+    traj
+}
+
 #[test]
 fn playback_shows_every_time_step_in_order_while_the_next_is_built_behind() {
     let d = scratch("view-play");
-    let traj = d.join("traj.xyz");
     // Three time steps of 20k atoms: each build takes far longer than a 48×48 frame.
-    let mut c = bnsview();
-    c.args([
-        "generate", "ns90k", "--atoms", "20000", "--frames", "3", "-o",
-    ])
-    .arg(&traj);
-    let (ok, _, err) = run(&mut c);
-    assert!(ok, "{err}");
+    let traj = ns90k_steps(&d, 3);
     let shot = |k: usize| d.join(format!("step{k}.png"));
     // Play while orbiting a little every frame (so frames keep coming during builds), then
     // a screenshot of each time step, stepped to with the keys.
@@ -290,12 +296,7 @@ fn bad_scripts_missing_displays_and_existing_files_are_clear_errors() {
 fn the_first_step_shows_what_the_mode_needs_first_and_the_volume_follows_behind() {
     let d = scratch("view-upgrade");
     // A 20k-atom trajectory: its volume takes far longer to build than a 48×48 frame.
-    let traj = d.join("traj.xyz");
-    let mut c = bnsview();
-    c.args(["generate", "ns90k", "--atoms", "20000", "-o"])
-        .arg(&traj);
-    let (ok, _, err) = run(&mut c);
-    assert!(ok, "{err}");
+    let traj = ns90k_steps(&d, 1);
     // The vol+bs key once everything is built, and right after the first frame (while the
     // volume is still on its way: the key then waits for it rather than asking for more).
     for (name, start) in [("still", "wait-still"), ("early", "wait-frames 1")] {
@@ -343,4 +344,26 @@ fn the_first_step_shows_what_the_mode_needs_first_and_the_volume_follows_behind(
             );
         }
     }
+}
+
+#[test]
+fn two_quick_steps_go_two_steps_and_the_step_passed_over_is_not_built() {
+    let d = scratch("view-steps");
+    let traj = ns90k_steps(&d, 3);
+    // Two presses of → at once (the second before the first step has arrived).
+    let script = "wait-still\nkey right\nkey right\nwait-still\nquit\n";
+    let (_, lines) = view_logged(&traj, &[], script, &d, "steps");
+    let loaded: Vec<&str> = lines
+        .iter()
+        .filter(|l| field(l, "loaded").is_some() && field(l, "upgrade") == Some("false"))
+        .map(|l| field(l, "loaded").unwrap())
+        .collect();
+    // Step 2, not step 1 twice; step 1 is dropped or stopped, never finished and thrown away.
+    assert_eq!(loaded, ["0", "2"], "{lines:?}");
+    assert!(
+        lines.iter().all(|l| field(l, "discarded").is_none()),
+        "{lines:?}"
+    );
+    let last = lines.iter().rev().find(|l| field(l, "presented").is_some());
+    assert_eq!(last.and_then(|l| field(l, "frame")), Some("2"), "{lines:?}");
 }

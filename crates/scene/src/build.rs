@@ -11,9 +11,9 @@ use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
-    build_density, density_work, ClassifiedTf, DensityParams, EmptySpace, Grid, LightVolume,
+    build_density_until, density_work, ClassifiedTf, DensityParams, EmptySpace, Grid, LightVolume,
     Macrocells, MarchOptions, Medium, ParticleScene, Particles, TransferFunction, Volume,
-    VolumeScene,
+    VolumeError, VolumeScene,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -73,21 +73,40 @@ pub struct Progress<'a> {
     pub stage: &'a dyn Fn(Stage, u64),
     /// Units finished in the running stage (shared: a file reader counts into it).
     pub done: Arc<AtomicU64>,
+    /// Asked at each stage's start and before each of the density's slab passes; once it
+    /// returns true the build stops with [`SceneError::Cancelled`] (a viewer's loader stops
+    /// building a time step the user has moved past).
+    pub cancelled: &'a (dyn Fn() -> bool + Sync),
 }
 
 impl Progress<'_> {
-    /// Progress reported nowhere.
+    /// Progress reported nowhere, never cancelled.
     pub fn none() -> Progress<'static> {
         Progress {
             stage: &|_, _| {},
             done: Arc::new(AtomicU64::new(0)),
+            cancelled: &|| false,
         }
     }
 
-    /// Announces `stage` of `total` units and resets `done`.
-    pub(crate) fn start(&self, stage: Stage, total: u64) {
+    /// Progress reported to `stage` and `done`, never cancelled.
+    pub fn new<'a>(stage: &'a dyn Fn(Stage, u64), done: Arc<AtomicU64>) -> Progress<'a> {
+        Progress {
+            stage,
+            done,
+            cancelled: &|| false,
+        }
+    }
+
+    /// Announces `stage` of `total` units and resets `done`; [`SceneError::Cancelled`]
+    /// instead when the build is no longer wanted.
+    pub(crate) fn start(&self, stage: Stage, total: u64) -> Result<(), SceneError> {
+        if (self.cancelled)() {
+            return Err(SceneError::Cancelled);
+        }
         (self.stage)(stage, total);
         self.done.store(0, Ordering::Relaxed);
+        Ok(())
     }
 }
 
@@ -258,7 +277,7 @@ impl Scene {
             check_model(ms)?;
         }
         if st.model.is_some() || st.bonds.unwrap {
-            progress.start(Stage::Bonds, m.len() as u64);
+            progress.start(Stage::Bonds, m.len() as u64)?;
         }
         let t = Instant::now();
         let keep_crossing = st.model.as_ref().is_some_and(|ms| ms.periodic_bonds);
@@ -298,7 +317,7 @@ impl Scene {
         }
         if let Some(ms) = &st.model {
             let prims = model_prim_count(m.len(), self.bonds.len(), ms).1;
-            progress.start(Stage::Model, prims as u64);
+            progress.start(Stage::Model, prims as u64)?;
             let t = Instant::now();
             let model = build_model(m, &self.bonds, ms, &mut self.scratch, &progress.done)?;
             if ms.wide_bvh {
@@ -325,18 +344,12 @@ impl Scene {
                         .estimate
                         .volume_dims
                         .map_or(0, |d| density_work(d, vs.format));
-                    progress.start(Stage::Volume, units);
+                    progress.start(Stage::Volume, units)?;
                     let t = Instant::now();
-                    let volume = build_volume(
-                        isa,
-                        m,
-                        vs,
-                        st.budget_bytes,
-                        &mut self.scratch.0,
-                        &progress.done,
-                    )?;
+                    let volume =
+                        build_volume(isa, m, vs, st.budget_bytes, &mut self.scratch.0, progress)?;
                     self.timings.volume = t.elapsed().as_secs_f64();
-                    progress.start(Stage::Macrocells, 1);
+                    progress.start(Stage::Macrocells, 1)?;
                     let t = Instant::now();
                     let cells = Macrocells::build(&volume);
                     self.timings.macrocells = t.elapsed().as_secs_f64();
@@ -360,7 +373,7 @@ impl Scene {
                             value: vs.voxels_per_angstrom,
                         });
                     }
-                    progress.start(Stage::Volume, 1);
+                    progress.start(Stage::Volume, 1)?;
                     let t = Instant::now();
                     density_radii(m, &mut self.scratch.0);
                     let p = Particles::build(
@@ -390,7 +403,7 @@ impl Scene {
                 progress.start(
                     Stage::LightVolume,
                     LightVolume::planes(&volume.grid, lv.stride),
-                );
+                )?;
                 let t = Instant::now();
                 let scene = VolumeScene::new(volume, cells, &d.tf, MarchOptions::default());
                 self.light_volume = Some(LightVolume::build_with_progress(
@@ -403,6 +416,9 @@ impl Scene {
                 self.timings.light_volume = t.elapsed().as_secs_f64();
             }
             self.volume = Some(d);
+        }
+        if (progress.cancelled)() {
+            return Err(SceneError::Cancelled);
         }
         self.sphere = bounding_sphere(m, self.model.as_ref());
         Ok(())
@@ -752,7 +768,7 @@ fn build_volume(
     vs: &VolumeSettings,
     budget_bytes: Option<u64>,
     radii: &mut Vec<f32>,
-    done: &AtomicU64,
+    progress: &Progress,
 ) -> Result<Volume, SceneError> {
     density_radii(m, radii);
     let params = DensityParams {
@@ -760,15 +776,11 @@ fn build_volume(
         format: vs.format,
         budget_bytes,
     };
-    Ok(build_density(
-        isa,
-        &m.x,
-        &m.y,
-        &m.z,
-        radii,
-        &params,
-        Some(done),
-    )?)
+    let (done, cancelled) = (&*progress.done, progress.cancelled);
+    match build_density_until(isa, &m.x, &m.y, &m.z, radii, &params, done, cancelled) {
+        Err(VolumeError::Cancelled) => Err(SceneError::Cancelled),
+        r => Ok(r?),
+    }
 }
 
 impl VolumeSettings {
@@ -779,7 +791,7 @@ impl VolumeSettings {
         isa: Isa,
         m: &Molecule,
     ) -> Result<(Volume, Macrocells), SceneError> {
-        let v = build_volume(isa, m, self, None, &mut Vec::new(), &AtomicU64::new(0))?;
+        let v = build_volume(isa, m, self, None, &mut Vec::new(), &Progress::none())?;
         let c = Macrocells::build(&v);
         Ok((v, c))
     }

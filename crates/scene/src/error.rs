@@ -75,6 +75,10 @@ pub enum SceneError {
         /// The frame asked for.
         frame: i64,
     },
+    /// The build was stopped by its [`crate::Progress::cancelled`] test before it finished
+    /// (e.g. a viewer whose user moved on to another time step); nothing was kept.
+    #[error("the scene's build was cancelled")]
+    Cancelled,
     /// The density volume failed (bad input, resolution or over its own budget); its
     /// message names the volume (shown once, also in an error chain).
     #[error(transparent)]

@@ -99,7 +99,7 @@ impl Input {
                 if frame != 0 {
                     return Err(SceneError::OneFrame { frame });
                 }
-                progress.start(Stage::Generate, 1);
+                progress.start(Stage::Generate, 1)?;
                 l.source = format!("scene {name} (seed {seed})");
                 l.molecule = try_generate(*name, *atoms, *seed)?;
             }
@@ -112,10 +112,10 @@ impl Input {
                 let units = bytes.filter(|_| !t.is_gzip()).unwrap_or(0);
                 l.frames = None;
                 if count_frames || frame < 0 {
-                    progress.start(Stage::CountFrames, units);
+                    progress.start(Stage::CountFrames, units)?;
                     l.frames = Some(t.count_frames()?);
                 }
-                progress.start(Stage::Read, units);
+                progress.start(Stage::Read, units)?;
                 l.molecule = t.read_frame_at(FrameIndex::from(frame))?;
                 l.source = path.display().to_string();
                 (l.format, l.file_bytes) = (Some(t.format()), bytes);

@@ -1,6 +1,7 @@
 //! Scene::build_with's progress: every stage that starts is announced with its units of work,
 //! and its counter ends exactly there (so a bar reaches 100 % and never passes it), for both
-//! volume formats and with unwrapping; the scene is the same as without progress.
+//! volume formats and with unwrapping; the scene is the same as without progress. A build
+//! whose cancel test turns true stops at the next stage or slab pass with `Cancelled`.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -9,7 +10,7 @@ mod common;
 
 use molecule::scenes::{generate, SceneName};
 use molecule::Cell;
-use scene::{BondSettings, ModelSettings, Progress, Scene, SceneSettings, Stage};
+use scene::{BondSettings, ModelSettings, Progress, Scene, SceneError, SceneSettings, Stage};
 use spmd::Isa;
 use volume::VolumeFormat;
 
@@ -30,10 +31,7 @@ fn with_stages<T>(work: impl FnOnce(&Progress) -> T) -> (T, Vec<(Stage, u64, u64
         }
         v.push((s, units, 0));
     };
-    let progress = Progress {
-        stage: &stage,
-        done: done.clone(),
-    };
+    let progress = Progress::new(&stage, done.clone());
     let out = work(&progress);
     let mut v = seen.into_inner().unwrap();
     if let Some(last) = v.last_mut() {
@@ -152,4 +150,85 @@ fn loading_counts_the_file_bytes_read_and_scanned() {
     let e = builtin.load(1, false, &Progress::none()).unwrap_err();
     assert!(e.to_string().contains("single frame"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Builds `st` over `m` with the cancel test `stop(stage announced last, units done)` and
+/// returns the outcome, the stages announced and the units done when it returned.
+fn build_until(
+    m: &molecule::Molecule,
+    st: &SceneSettings,
+    stop: impl Fn(Option<Stage>, u64) -> bool + Sync,
+) -> (Result<Scene, SceneError>, Vec<Stage>, u64) {
+    let done = Arc::new(AtomicU64::new(0));
+    let seen: Mutex<Vec<Stage>> = Mutex::new(Vec::new());
+    let stage = |s: Stage, _| seen.lock().unwrap().push(s);
+    let cancelled = || {
+        stop(
+            seen.lock().unwrap().last().copied(),
+            done.load(Ordering::Relaxed),
+        )
+    };
+    let progress = Progress {
+        cancelled: &cancelled,
+        ..Progress::new(&stage, done.clone())
+    };
+    let out = Scene::build_with(Isa::Scalar, m, st, &progress);
+    let counted = done.load(Ordering::Relaxed);
+    (out, seen.into_inner().unwrap(), counted)
+}
+
+#[test]
+fn a_cancelled_build_stops_at_the_next_stage() {
+    let m = generate(SceneName::Nanobowl, Some(3000), 1);
+    let st = settings(VolumeFormat::U8, false);
+    // Cancelled before it starts: nothing is announced.
+    let (r, seen, _) = build_until(&m, &st, |_, _| true);
+    assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
+    assert!(seen.is_empty(), "{seen:?}");
+    // Cancelled once the BVH has started: the BVH finishes, the volume never starts.
+    let (r, seen, _) = build_until(&m, &st, |s, _| s == Some(Stage::Model));
+    assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
+    assert_eq!(seen, [Stage::Bonds, Stage::Model]);
+    let e = r.err().unwrap().to_string();
+    assert!(e.contains("cancelled"), "{e}");
+    // Never cancelled: every stage, and a scene.
+    let (r, seen, _) = build_until(&m, &st, |_, _| false);
+    assert!(r.is_ok());
+    assert_eq!(seen.len(), 5, "{seen:?}");
+}
+
+#[test]
+fn a_build_cancelled_inside_the_density_skips_its_remaining_slab_passes() {
+    let m = generate(SceneName::Nanobowl, Some(3000), 1);
+    for format in [VolumeFormat::U8, VolumeFormat::F32] {
+        let st = settings(format, false);
+        let units = Scene::build(Isa::Scalar, &m, &st)
+            .unwrap()
+            .estimate
+            .volume_dims
+            .map(|d| volume::density_work(d, format))
+            .unwrap();
+        let stop = |s: Option<Stage>, done: u64| s == Some(Stage::Volume) && done >= 1;
+        // Cancelled as soon as one slab pass of the density is done: on one thread, no
+        // other slab pass runs.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let (r, seen, counted) = one.install(|| build_until(&m, &st, stop));
+        assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
+        assert_eq!(seen.last(), Some(&Stage::Volume), "{format:?}");
+        assert!(units > 2, "{format:?}: {units}");
+        assert_eq!(counted, 1, "{format:?}: {counted} of {units} slab passes");
+        // On every thread, those in flight finish; for u8, which takes two passes over the
+        // slabs (the maximum, then the values), the second never starts.
+        let (r, _, counted) = build_until(&m, &st, stop);
+        assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
+        if format == VolumeFormat::U8 {
+            assert!(
+                counted <= units / 2,
+                "{format:?}: {counted} of {units} slab passes"
+            );
+        }
+    }
 }

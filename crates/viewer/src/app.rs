@@ -85,6 +85,8 @@ struct App {
     playing: bool,
     /// The newest request: (id, frame).
     waiting: Option<(u64, usize)>,
+    /// The settings of the waiting request.
+    asked: Option<SceneSettings>,
     /// The first time step's scene with the model and the volume, asked for once that step is
     /// on screen (so that mode keys need no build): its settings until asked for, then the
     /// request's id.
@@ -162,6 +164,7 @@ pub fn run(cfg: ViewConfig, source: FrameSource) -> Result<ViewReport, ViewError
         frames: None,
         playing: false,
         waiting: None,
+        asked: None,
         upgrade: Upgrade::None,
         next_id: 0,
         ranges: None,
@@ -211,6 +214,12 @@ impl App {
     }
 
     fn request(&mut self, frame: usize, settings: SceneSettings) {
+        // The same scene is already on its way: asking again would only restart its build
+        // (a newer request stops the one being built).
+        if self.waiting.is_some_and(|w| w.1 == frame) && self.asked.as_ref() == Some(&settings) {
+            return;
+        }
+        self.asked = Some(settings.clone());
         self.next_id += 1;
         self.waiting = Some((self.next_id, frame));
         self.loader.request(Request {
@@ -363,7 +372,9 @@ impl App {
             Action::Step(d) => {
                 self.playing = false;
                 if let Some(s) = &self.shown {
-                    let k = s.frame as i64 + d as i64;
+                    // From the step on its way, if any: two quick presses go two steps.
+                    let from = self.waiting.map_or(s.frame, |w| w.1);
+                    let k = from as i64 + d as i64;
                     let last = self.frames.map_or(i64::MAX, |n| n as i64 - 1);
                     self.go_to(k.clamp(0, last.max(0)) as usize);
                 }
@@ -479,6 +490,13 @@ impl App {
                     if self.upgrade.is(id) {
                         self.upgrade = Upgrade::None;
                     }
+                }
+                Answer::Cancelled { id, frame, spent_s } => {
+                    // As skipped, but stopped part way: logged, so the time it cost shows.
+                    if self.upgrade.is(id) {
+                        self.upgrade = Upgrade::None;
+                    }
+                    self.log(format!("\"cancelled\":{frame},\"spent_s\":{spent_s:.6}"));
                 }
                 Answer::Built {
                     id,

@@ -3,13 +3,15 @@
 //! for a build and its frames keep their speed; the window polls for the result and swaps it
 //! in when it is ready.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, Receiver, Sender, TryRecvError};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
 
 use molecule::read::{FrameIndex, Trajectory};
 use molecule::Molecule;
-use scene::{Scene, SceneError, SceneSettings};
+use scene::{Progress, Scene, SceneError, SceneSettings};
 use spmd::Isa;
 
 /// Where the time steps come from.
@@ -92,6 +94,15 @@ pub enum Answer {
         /// The request's id.
         id: u64,
     },
+    /// A request whose build was stopped part way because a newer one came.
+    Cancelled {
+        /// The request's id.
+        id: u64,
+        /// Its time step.
+        frame: usize,
+        /// Seconds spent reading and building before it stopped.
+        spent_s: f64,
+    },
     /// How many time steps the source has (counted after the first scene is built).
     Frames(Result<usize, String>),
 }
@@ -99,6 +110,8 @@ pub enum Answer {
 /// The loader thread and its channels.
 pub struct Loader {
     tx: Option<Sender<Request>>,
+    /// Id of the newest request sent: a build of any other is no longer wanted.
+    newest: Arc<AtomicU64>,
     rx: Receiver<Answer>,
     pending: usize,
     handle: Option<JoinHandle<()>>,
@@ -109,20 +122,26 @@ impl Loader {
     pub fn start(source: FrameSource, isa: Isa, threads: usize) -> Loader {
         let (tx, requests) = channel::<Request>();
         let (answers, rx) = channel();
+        let newest = Arc::new(AtomicU64::new(0));
+        let wanted = newest.clone();
         let handle = std::thread::Builder::new()
             .name("bnsview-loader".into())
-            .spawn(move || serve(source, isa, threads, requests, answers))
+            .spawn(move || serve(source, isa, threads, requests, answers, wanted))
             .ok();
         Loader {
             tx: Some(tx),
+            newest,
             rx,
             pending: 0,
             handle,
         }
     }
 
-    /// Asks for a scene; requests made before it that are not started yet are dropped.
+    /// Asks for a scene; requests made before it that are not started yet are dropped, and
+    /// one being built stops at its next check (ids must grow from one request to the next).
     pub fn request(&mut self, r: Request) {
+        // Before the send, so the loader never builds this request while it looks stale.
+        self.newest.store(r.id, Ordering::Relaxed);
         if let Some(tx) = &self.tx {
             if tx.send(r).is_ok() {
                 self.pending += 1;
@@ -134,7 +153,8 @@ impl Loader {
     pub fn poll(&mut self) -> Option<Answer> {
         match self.rx.try_recv() {
             Ok(a) => {
-                if let Answer::Built { .. } | Answer::Skipped { .. } = a {
+                if let Answer::Built { .. } | Answer::Skipped { .. } | Answer::Cancelled { .. } = a
+                {
                     self.pending = self.pending.saturating_sub(1);
                 }
                 Some(a)
@@ -180,13 +200,15 @@ fn yield_to_the_window() {
 }
 
 /// The loader thread: the newest request first (older waiting ones are answered as
-/// skipped), read, build on the loader's own pool, send.
+/// skipped), read, build on the loader's own pool (stopped as soon as a newer request is
+/// made: answered as cancelled), send.
 fn serve(
     mut source: FrameSource,
     isa: Isa,
     threads: usize,
     requests: Receiver<Request>,
     answers: Sender<Answer>,
+    newest: Arc<AtomicU64>,
 ) {
     yield_to_the_window();
     let pool = rayon::ThreadPoolBuilder::new()
@@ -203,23 +225,37 @@ fn serve(
             }
             r = newer;
         }
-        let t = Instant::now();
+        let t0 = Instant::now();
         let m = source.read(r.frame);
-        let read_s = t.elapsed().as_secs_f64();
+        let read_s = t0.elapsed().as_secs_f64();
         let t = Instant::now();
-        let scene = m.and_then(|m| {
-            let build = || Scene::build(isa, &m, &r.settings).map_err(|e| e.to_string());
-            match &pool {
-                Ok(p) => p.install(build),
-                Err(_) => build(),
-            }
-        });
-        let answer = Answer::Built {
+        let stale = || newest.load(Ordering::Relaxed) != r.id;
+        let done = |scene: Result<Scene, String>| Answer::Built {
             id: r.id,
             frame: r.frame,
             scene: scene.map(Box::new),
             read_s,
             build_s: t.elapsed().as_secs_f64(),
+        };
+        let answer = match m {
+            Ok(m) => {
+                let build = || {
+                    let progress = Progress {
+                        cancelled: &stale,
+                        ..Progress::none()
+                    };
+                    Scene::build_with(isa, &m, &r.settings, &progress)
+                };
+                match pool.as_ref().map_or_else(|_| build(), |p| p.install(build)) {
+                    Err(SceneError::Cancelled) => Answer::Cancelled {
+                        id: r.id,
+                        frame: r.frame,
+                        spent_s: t0.elapsed().as_secs_f64(),
+                    },
+                    scene => done(scene.map_err(|e| e.to_string())),
+                }
+            }
+            Err(e) => done(Err(e)),
         };
         if answers.send(answer).is_err() {
             return;
@@ -230,5 +266,61 @@ fn serve(
                 return;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::{Duration, Instant};
+
+    use molecule::scenes::{generate, SceneName};
+    use scene::{ModelSettings, SceneSettings, VolumeSettings};
+    use spmd::Isa;
+
+    use super::*;
+
+    #[test]
+    fn a_newer_request_stops_the_build_in_progress() {
+        // A density volume of 90K atoms on the scalar backend: seconds of work, so the
+        // second request comes while the first is read or built.
+        let m = generate(SceneName::Ns90k, None, 1);
+        let source = FrameSource::One(Box::new(m), "ns90k".into());
+        let mut l = Loader::start(source, Isa::Scalar, 2);
+        let full = SceneSettings {
+            model: Some(ModelSettings::default()),
+            volume: Some(VolumeSettings::default()),
+            budget_bytes: Some(u64::MAX),
+            ..SceneSettings::default()
+        };
+        let model = SceneSettings {
+            volume: None,
+            ..full.clone()
+        };
+        l.request(Request {
+            id: 1,
+            frame: 0,
+            settings: full,
+        });
+        std::thread::sleep(Duration::from_millis(50));
+        l.request(Request {
+            id: 2,
+            frame: 0,
+            settings: model,
+        });
+        let start = Instant::now();
+        let mut first = Vec::new();
+        let second = loop {
+            assert!(start.elapsed() < Duration::from_secs(300), "no answer");
+            match l.poll() {
+                Some(Answer::Built { id: 2, scene, .. }) => break scene.unwrap(),
+                Some(Answer::Built { id, .. }) => panic!("request {id} was built to the end"),
+                Some(Answer::Skipped { id }) | Some(Answer::Cancelled { id, .. }) => first.push(id),
+                Some(Answer::Frames(_)) => {}
+                None => std::thread::sleep(Duration::from_millis(5)),
+            }
+        };
+        assert_eq!(first, [1]);
+        assert!(second.volume.is_none() && second.model.is_some());
+        assert!(!l.busy());
     }
 }

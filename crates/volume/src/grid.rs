@@ -339,6 +339,23 @@ pub fn build_density(
 ) -> Result<Volume, VolumeError> {
     let unwatched = AtomicU64::new(0);
     let done = done.unwrap_or(&unwatched);
+    build_density_until(isa, x, y, z, r, params, done, &|| false)
+}
+
+/// [`build_density`] that stops early with [`VolumeError::Cancelled`] once `cancelled()`
+/// returns true: it is asked before each slab pass (a fraction of a second's work on a
+/// million atoms), so a caller whose result is no longer wanted gets its cores back soon.
+#[allow(clippy::too_many_arguments)]
+pub fn build_density_until(
+    isa: Isa,
+    x: &[f32],
+    y: &[f32],
+    z: &[f32],
+    r: &[f32],
+    params: &DensityParams,
+    done: &AtomicU64,
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Result<Volume, VolumeError> {
     let grid = Grid::for_atoms(x, y, z, r, params.voxels_per_angstrom)?;
     let needed = estimate_bytes(&grid, params.format);
     let budget = params.budget_bytes.or_else(default_budget_bytes);
@@ -390,6 +407,9 @@ pub fn build_density(
                 .enumerate()
                 .map_init(Vec::new, |buf: &mut Vec<f32>, (slab, out)| {
                     let mut m = 0.0f32;
+                    if cancelled() {
+                        return m;
+                    }
                     ctx.splat(slab, buf, |p, y0, block| {
                         let o = (p * ny + y0) * nx;
                         out[o..o + block.len()].copy_from_slice(block);
@@ -399,6 +419,9 @@ pub fn build_density(
                     m
                 })
                 .reduce(|| 0.0, f32::max);
+            if cancelled() {
+                return Err(VolumeError::Cancelled);
+            }
             Ok(Volume {
                 grid,
                 data: VolumeData::F32(data),
@@ -412,11 +435,17 @@ pub fn build_density(
                 .into_par_iter()
                 .map_init(Vec::new, |buf: &mut Vec<f32>, slab| {
                     let mut m = 0.0f32;
+                    if cancelled() {
+                        return m;
+                    }
                     ctx.splat(slab, buf, |_, _, block| m = fmax(m, block));
                     done.fetch_add(1, Ordering::Relaxed);
                     m
                 })
                 .reduce(|| 0.0, f32::max);
+            if cancelled() {
+                return Err(VolumeError::Cancelled);
+            }
             let scale = if max_value > 0.0 {
                 max_value / 255.0
             } else {
@@ -430,6 +459,9 @@ pub fn build_density(
                 .par_chunks_mut(SLAB * plane)
                 .enumerate()
                 .for_each_init(Vec::new, |buf: &mut Vec<f32>, (slab, out)| {
+                    if cancelled() {
+                        return;
+                    }
                     ctx.splat(slab, buf, |p, y0, block| {
                         let o = (p * ny + y0) * nx;
                         isa.dispatch(Quantise {
@@ -440,6 +472,9 @@ pub fn build_density(
                     });
                     done.fetch_add(1, Ordering::Relaxed);
                 });
+            if cancelled() {
+                return Err(VolumeError::Cancelled);
+            }
             Ok(Volume {
                 grid,
                 data: VolumeData::U8 { data, scale },

@@ -94,8 +94,8 @@ pub mod tf;
 
 pub use empty_space::EmptySpace;
 pub use grid::{
-    build_density, default_budget_bytes, density_work, estimate_bytes, DensityParams, Grid, Volume,
-    VolumeData, VolumeFormat,
+    build_density, build_density_until, default_budget_bytes, density_work, estimate_bytes,
+    DensityParams, Grid, Volume, VolumeData, VolumeFormat,
 };
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{classify_values, march, march_rays, Rays};
@@ -147,6 +147,10 @@ pub enum VolumeError {
     /// Unknown storage format name.
     #[error("unknown volume format {0:?}: expected u8 or f32")]
     UnknownFormat(String),
+    /// The build was stopped by its caller's cancel test (e.g. a viewer that no longer
+    /// needs this time step); nothing was kept.
+    #[error("the density volume's build was cancelled")]
+    Cancelled,
     /// The grid would not fit in memory (or exceeds 2³¹ voxels, the gather index limit).
     #[error(
         "the {format} density volume at {voxels_per_angstrom} voxels/Å would be {}x{}x{} voxels, \

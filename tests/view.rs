@@ -367,3 +367,31 @@ fn two_quick_steps_go_two_steps_and_the_step_passed_over_is_not_built() {
     let last = lines.iter().rev().find(|l| field(l, "presented").is_some());
     assert_eq!(last.and_then(|l| field(l, "frame")), Some("2"), "{lines:?}");
 }
+
+#[test]
+fn stepping_back_to_the_step_on_screen_builds_nothing() {
+    let d = scratch("view-back");
+    let traj = ns90k_steps(&d, 3);
+    // `←` on the first step; `→` and `←` at once; then the vol+bs key, which the first
+    // step's upgrade (model and volume) serves.
+    let script = "wait-still\nkey left\nwait-still\nkey right\nkey left\nwait-still\nkey 3\nwait-frames 1\nwait-still\nquit\n";
+    let (_, lines) = view_logged(&traj, &["--mode", "bs"], script, &d, "back");
+    let loaded: Vec<(&str, &str)> = lines
+        .iter()
+        .filter(|l| field(l, "loaded").is_some())
+        .map(|l| (field(l, "loaded").unwrap(), field(l, "upgrade").unwrap()))
+        .collect();
+    // Step 0 and its upgrade only: not rebuilt, step 1 never finished.
+    assert_eq!(loaded, [("0", "false"), ("0", "true")], "{lines:?}");
+    assert!(
+        lines.iter().all(|l| field(l, "discarded").is_none()),
+        "{lines:?}"
+    );
+    let modes: Vec<(&str, &str)> = lines
+        .iter()
+        .filter(|l| field(l, "presented").is_some())
+        .map(|l| (field(l, "frame").unwrap(), field(l, "mode").unwrap()))
+        .collect();
+    assert!(modes.iter().all(|m| m.0 == "0"), "{modes:?}");
+    assert_eq!(modes.last(), Some(&("0", "vol+bs")), "{modes:?}");
+}

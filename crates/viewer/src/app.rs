@@ -454,6 +454,19 @@ impl App {
                 return;
             }
         }
+        // Back to the step on screen (`←` on the first, `→` then `←`): a step on its way is
+        // no longer wanted, and the scene on screen serves the toggles if it can (it may hold
+        // the volume too: rebuilding it would lose that).
+        if self.shown.as_ref().is_some_and(|s| s.frame == k) {
+            if self.waiting.is_some_and(|w| w.1 != k) {
+                self.waiting = None;
+                self.next_id += 1;
+                self.loader.withdraw(self.next_id);
+            }
+            let t = self.pending.take().unwrap_or(self.toggles);
+            self.set_toggles(t);
+            return;
+        }
         let t = self.pending.unwrap_or(self.toggles);
         match self.needs(&t) {
             Ok((s, _)) => self.request(k, s),

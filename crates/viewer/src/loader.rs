@@ -149,6 +149,13 @@ impl Loader {
         }
     }
 
+    /// No request made so far is wanted any more: one being built stops at its next check
+    /// and is answered as cancelled. `id` is greater than every request's so far and below
+    /// every later one's.
+    pub fn withdraw(&mut self, id: u64) {
+        self.newest.store(id, Ordering::Relaxed);
+    }
+
     /// An answer, if one is ready (never waits).
     pub fn poll(&mut self) -> Option<Answer> {
         match self.rx.try_recv() {

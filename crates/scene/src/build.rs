@@ -11,9 +11,9 @@ use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
 use volume::{
-    build_density_until, density_work, ClassifiedTf, DensityParams, EmptySpace, Grid, LightVolume,
+    build_density, density_work, ClassifiedTf, DensityParams, EmptySpace, Grid, LightVolume,
     Macrocells, MarchOptions, Medium, ParticleScene, Particles, TransferFunction, Volume,
-    VolumeError, VolumeScene,
+    VolumeError, VolumeScene, Watch,
 };
 
 use crate::fit::{bounding_sphere, Sphere};
@@ -776,8 +776,11 @@ fn build_volume(
         format: vs.format,
         budget_bytes,
     };
-    let (done, cancelled) = (&*progress.done, progress.cancelled);
-    match build_density_until(isa, &m.x, &m.y, &m.z, radii, &params, done, cancelled) {
+    let watch = Watch {
+        done: &progress.done,
+        cancelled: progress.cancelled,
+    };
+    match build_density(isa, &m.x, &m.y, &m.z, radii, &params, Some(&watch)) {
         Err(VolumeError::Cancelled) => Err(SceneError::Cancelled),
         r => Ok(r?),
     }

@@ -311,6 +311,16 @@ pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
     dims[2].div_ceil(SLAB) as u64 * passes
 }
 
+/// Who watches a density build from another thread.
+pub struct Watch<'a> {
+    /// Gains one per finished slab pass (up to [`density_work`]), for a progress display.
+    pub done: &'a AtomicU64,
+    /// Asked before each slab pass: once it returns true, the remaining passes are skipped
+    /// and the build returns [`VolumeError::Cancelled`] (a caller whose result is no longer
+    /// wanted gets its cores back within a fraction of a second).
+    pub cancelled: &'a (dyn Fn() -> bool + Sync),
+}
+
 /// Builds the density volume of the atoms (positions `x, y, z` and covalent radii `r`, Å)
 /// on [`Grid::for_atoms`] at `params.voxels_per_angstrom`, using backend `isa`.
 ///
@@ -326,8 +336,7 @@ pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
 /// resolution) when [`estimate_bytes`] exceeds the budget or the voxel count exceeds what
 /// 32-bit gather indices can address.
 ///
-/// `done`, if given, gains one per finished slab pass (up to [`density_work`]), for a
-/// progress display that reads it from another thread.
+/// `watch`, if given, counts the finished slab passes and can stop the build ([`Watch`]).
 pub fn build_density(
     isa: Isa,
     x: &[f32],
@@ -335,27 +344,13 @@ pub fn build_density(
     z: &[f32],
     r: &[f32],
     params: &DensityParams,
-    done: Option<&AtomicU64>,
+    watch: Option<&Watch>,
 ) -> Result<Volume, VolumeError> {
     let unwatched = AtomicU64::new(0);
-    let done = done.unwrap_or(&unwatched);
-    build_density_until(isa, x, y, z, r, params, done, &|| false)
-}
-
-/// [`build_density`] that stops early with [`VolumeError::Cancelled`] once `cancelled()`
-/// returns true: it is asked before each slab pass (a fraction of a second's work on a
-/// million atoms), so a caller whose result is no longer wanted gets its cores back soon.
-#[allow(clippy::too_many_arguments)]
-pub fn build_density_until(
-    isa: Isa,
-    x: &[f32],
-    y: &[f32],
-    z: &[f32],
-    r: &[f32],
-    params: &DensityParams,
-    done: &AtomicU64,
-    cancelled: &(dyn Fn() -> bool + Sync),
-) -> Result<Volume, VolumeError> {
+    let (done, cancelled): (&AtomicU64, &(dyn Fn() -> bool + Sync)) = match watch {
+        Some(w) => (w.done, w.cancelled),
+        None => (&unwatched, &|| false),
+    };
     let grid = Grid::for_atoms(x, y, z, r, params.voxels_per_angstrom)?;
     let needed = estimate_bytes(&grid, params.format);
     let budget = params.budget_bytes.or_else(default_budget_bytes);

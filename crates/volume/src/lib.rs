@@ -94,8 +94,8 @@ pub mod tf;
 
 pub use empty_space::EmptySpace;
 pub use grid::{
-    build_density, build_density_until, default_budget_bytes, density_work, estimate_bytes,
-    DensityParams, Grid, Volume, VolumeData, VolumeFormat,
+    build_density, default_budget_bytes, density_work, estimate_bytes, DensityParams, Grid, Volume,
+    VolumeData, VolumeFormat, Watch,
 };
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{classify_values, march, march_rays, Rays};

@@ -620,12 +620,19 @@ fn bin_atoms_by_slab(grid: &Grid, x: &[f32], y: &[f32], z: &[f32], r: &[f32]) ->
     }
     let inv = 1.0 / grid.spacing;
     bins.par_iter_mut().for_each(|b| {
-        b.sort_unstable_by_key(|&i| {
-            let i = i as usize;
-            let band = band_key(grid, y[i]);
-            let col = ((x[i] - grid.origin[0]) * inv) as u32;
-            (band, col, i as u32)
-        })
+        // Keys computed once per atom, not per comparison.
+        let mut keyed: Vec<(u64, u32)> = b
+            .iter()
+            .map(|&i| {
+                let band = band_key(grid, y[i as usize]) as u64;
+                let col = ((x[i as usize] - grid.origin[0]) * inv) as u32 as u64;
+                (band << 32 | col, i)
+            })
+            .collect();
+        keyed.sort_unstable();
+        for (slot, (_, i)) in b.iter_mut().zip(keyed) {
+            *slot = i;
+        }
     });
     bins
 }
@@ -645,16 +652,17 @@ struct SplatSlab<'a> {
 impl Kernel for SplatSlab<'_> {
     type Output = ();
     // Paper §3.1: "iterate over each atom, applying the RBF to each voxel it overlaps within
-    // the outer radius" — one slab of z-planes, SIMD over voxels along x.
+    // the outer radius" — one slab of z-planes, SIMD over voxels along x. The Gaussian is
+    // separable, exp(−d²/r²) = exp(−dx²/r²)·exp(−dy²/r²)·exp(−dz²/r²): each atom's three
+    // profiles are computed once per visit, so a row costs a product, not an `exp`.
     #[inline(always)]
     fn run<S: Simd>(self, s: S) {
         let g = self.grid;
         let (nx, ny) = (g.dims[0], g.dims[1]);
-        let _ = ny;
         let planes = self.out.len() / (nx * self.rows);
         let ylast = self.y0 + self.rows - 1;
         let h = g.spacing;
-        let lanes_f = s.to_f32(s.lane_index());
+        let (mut px, mut py, mut pz) = (Profile::new(), Profile::new(), Profile::new());
         for &ai in self.list {
             let ai = ai as usize;
             let (ax, ay, az, ar) = (
@@ -666,7 +674,7 @@ impl Kernel for SplatSlab<'_> {
             let cut2 = 2.0 * ar * ar;
             let reach = core::f32::consts::SQRT_2 * ar;
             let inv_r2 = s.splat(-1.0 / (ar * ar));
-            let amp = s.splat(ar.sqrt());
+            let amp = ar.sqrt();
             let cut2v = s.splat(cut2);
             let Some((zlo, zhi)) = lattice_range(az, reach, g.origin[2], h, g.dims[2]) else {
                 continue;
@@ -676,37 +684,44 @@ impl Kernel for SplatSlab<'_> {
             if zlo > zhi {
                 continue;
             }
+            // The support's extent along y and x (√cut2: the mask below is the exact test).
+            let wide = cut2.sqrt();
+            let Some((ylo0, yhi0)) = lattice_range(ay, wide, g.origin[1], h, ny) else {
+                continue;
+            };
+            let (ylo0, yhi0) = (ylo0.max(self.y0), yhi0.min(ylast));
+            let Some((xlo0, xhi0)) = lattice_range(ax, wide, g.origin[0], h, nx) else {
+                continue;
+            };
+            if ylo0 > yhi0 {
+                continue;
+            }
+            px.fill(s, [g.origin[0], h], ax, xlo0..xhi0 + 1, inv_r2);
+            py.fill(s, [g.origin[1], h], ay, ylo0..yhi0 + 1, inv_r2);
+            pz.fill(s, [g.origin[2], h], az, zlo..zhi + 1, inv_r2);
+            // Every row spans the atom's whole x range: the mask `d² < cut²` alone decides
+            // which points a row adds to (no square root and lattice range per row).
             for kz in zlo..=zhi {
                 let dz = g.origin[2] + kz as f32 * h - az;
-                let rz2 = cut2 - dz * dz;
-                if rz2 <= 0.0 {
+                if cut2 - dz * dz <= 0.0 {
                     continue;
                 }
-                let Some((ylo, yhi)) = lattice_range(ay, rz2.sqrt(), g.origin[1], h, ny) else {
-                    continue;
-                };
-                let (ylo, yhi) = (ylo.max(self.y0), yhi.min(ylast));
-                for jy in ylo..=yhi {
+                let fz = amp * pz.e[kz - zlo];
+                for jy in ylo0..=yhi0 {
                     let dy = g.origin[1] + jy as f32 * h - ay;
                     let dyz2 = dy * dy + dz * dz;
-                    let rx2 = cut2 - dyz2;
-                    if rx2 <= 0.0 {
+                    if cut2 - dyz2 <= 0.0 {
                         continue;
                     }
-                    let Some((xlo, xhi)) = lattice_range(ax, rx2.sqrt(), g.origin[0], h, nx) else {
-                        continue;
-                    };
                     let row = ((kz - self.z0) * self.rows + jy - self.y0) * nx;
                     let dyz2v = s.splat(dyz2);
-                    let mut ix = xlo;
-                    while ix <= xhi {
-                        let count = xhi + 1 - ix;
-                        // x of lane l: origin + (ix + l)·h, as Grid::point computes it.
-                        let gx = s.splat(ix as f32) + lanes_f;
-                        let dx = s.splat(g.origin[0]) + gx * s.splat(h) - s.splat(ax);
-                        let d2 = dx * dx + dyz2v;
-                        let m = s.first_n(count) & s.lt(d2, cut2v);
-                        let val = amp * spmd::math::exp(s, d2 * inv_r2);
+                    let fyz = s.splat(fz * py.e[jy - ylo0]);
+                    let mut ix = xlo0;
+                    while ix <= xhi0 {
+                        let o = ix - xlo0;
+                        let d2 = s.load(&px.d2[o..]) + dyz2v;
+                        let m = s.first_n(xhi0 + 1 - ix) & s.lt(d2, cut2v);
+                        let val = s.load(&px.e[o..]) * fyz;
                         let dst = &mut self.out[row + ix..];
                         let acc = s.load_partial(dst, 0.0);
                         s.store_masked(acc + val, dst, m);
@@ -714,6 +729,50 @@ impl Kernel for SplatSlab<'_> {
                     }
                 }
             }
+        }
+    }
+}
+
+/// One axis of an atom's Gaussian at the lattice points of a range: `d²` (Å², from the atom)
+/// and `exp(d²·c)` per point, padded by a vector of zeros so any point's vector loads whole.
+struct Profile {
+    d2: Vec<f32>,
+    e: Vec<f32>,
+}
+
+impl Profile {
+    fn new() -> Profile {
+        Profile {
+            d2: Vec::new(),
+            e: Vec::new(),
+        }
+    }
+
+    /// Fills the profile of coordinate `p` (Å) at points `range` of the lattice
+    /// `[origin, h]` (point i at `origin + i·h`, as [`Grid::point`] computes it).
+    #[inline(always)]
+    fn fill<S: Simd>(
+        &mut self,
+        s: S,
+        [origin, h]: [f32; 2],
+        p: f32,
+        range: core::ops::Range<usize>,
+        c: S::F32,
+    ) {
+        let n = range.len();
+        self.d2.clear();
+        self.e.clear();
+        self.d2.resize(n + S::LANES, 0.0);
+        self.e.resize(n + S::LANES, 0.0);
+        let lanes = s.to_f32(s.lane_index());
+        let mut o = 0;
+        while o < n {
+            let gi = s.splat((range.start + o) as f32) + lanes;
+            let d = s.splat(origin) + gi * s.splat(h) - s.splat(p);
+            let d2 = d * d;
+            s.store(d2, &mut self.d2[o..]);
+            s.store(spmd::math::exp(s, d2 * c), &mut self.e[o..]);
+            o += S::LANES;
         }
     }
 }

@@ -27,54 +27,13 @@ impl Macrocells {
         let dims: [usize; 3] = core::array::from_fn(|a| (g.dims[a] - 1).div_ceil(MACROCELL).max(1));
         let [cx, cy, cz] = dims;
         let mut minmax = vec![0.0f32; 2 * cx * cy * cz];
-        let [nx, ny, nz] = g.dims;
+        let scale = vol.scale().unwrap_or(1.0);
         minmax
             .par_chunks_mut(2 * cx * cy)
             .enumerate()
-            .for_each(|(k, out)| {
-                // Per lattice row y of this cell layer: min/max per cell along x.
-                let mut rmin = vec![f32::INFINITY; ny * cx];
-                let mut rmax = vec![f32::NEG_INFINITY; ny * cx];
-                let z0 = k * MACROCELL;
-                let z1 = (z0 + MACROCELL).min(nz - 1);
-                for z in z0..=z1 {
-                    for y in 0..ny {
-                        let base = nx * (y + ny * z);
-                        for i in 0..cx {
-                            let x0 = i * MACROCELL;
-                            let x1 = (x0 + MACROCELL).min(nx - 1);
-                            let (mn, mx) = match &vol.data {
-                                VolumeData::F32(v) => {
-                                    minmax_of(v[base + x0..=base + x1].iter().copied())
-                                }
-                                VolumeData::U8 { data, .. } => {
-                                    let (a, b) = data[base + x0..=base + x1]
-                                        .iter()
-                                        .fold((u8::MAX, 0u8), |(a, b), &q| (a.min(q), b.max(q)));
-                                    (a as f32, b as f32)
-                                }
-                            };
-                            let o = y * cx + i;
-                            rmin[o] = rmin[o].min(mn);
-                            rmax[o] = rmax[o].max(mx);
-                        }
-                    }
-                }
-                let scale = vol.scale().unwrap_or(1.0);
-                for j in 0..cy {
-                    let y0 = j * MACROCELL;
-                    let y1 = (y0 + MACROCELL).min(ny - 1);
-                    for i in 0..cx {
-                        let (mut mn, mut mx) = (f32::INFINITY, f32::NEG_INFINITY);
-                        for y in y0..=y1 {
-                            mn = mn.min(rmin[y * cx + i]);
-                            mx = mx.max(rmax[y * cx + i]);
-                        }
-                        // u8: q·scale is exactly how the kernels dequantise.
-                        out[2 * (j * cx + i)] = mn * scale;
-                        out[2 * (j * cx + i) + 1] = mx * scale;
-                    }
-                }
+            .for_each(|(k, out)| match &vol.data {
+                VolumeData::F32(v) => layer(v, g.dims, [cx, cy], k, scale, out),
+                VolumeData::U8 { data, .. } => layer(data, g.dims, [cx, cy], k, scale, out),
             });
         Macrocells { dims, minmax }
     }
@@ -91,8 +50,85 @@ impl Macrocells {
     }
 }
 
-fn minmax_of(it: impl Iterator<Item = f32>) -> (f32, f32) {
-    it.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
-        (a.min(v), b.max(v))
-    })
+/// A lattice value: what a min/max reduction over it needs.
+trait Value: Copy {
+    /// The identity of `min` (the largest value).
+    const TOP: Self;
+    /// The identity of `max`.
+    const BOTTOM: Self;
+    fn min(self, o: Self) -> Self;
+    fn max(self, o: Self) -> Self;
+    /// The value as the kernels dequantise it (`scale`: the step of a u8 volume, 1 for f32).
+    fn value(self, scale: f32) -> f32;
+}
+
+impl Value for f32 {
+    const TOP: f32 = f32::INFINITY;
+    const BOTTOM: f32 = f32::NEG_INFINITY;
+    fn min(self, o: f32) -> f32 {
+        f32::min(self, o)
+    }
+    fn max(self, o: f32) -> f32 {
+        f32::max(self, o)
+    }
+    fn value(self, scale: f32) -> f32 {
+        self * scale
+    }
+}
+
+impl Value for u8 {
+    const TOP: u8 = u8::MAX;
+    const BOTTOM: u8 = 0;
+    fn min(self, o: u8) -> u8 {
+        Ord::min(self, o)
+    }
+    fn max(self, o: u8) -> u8 {
+        Ord::max(self, o)
+    }
+    fn value(self, scale: f32) -> f32 {
+        // q·scale is exactly how the kernels dequantise.
+        self as f32 * scale
+    }
+}
+
+/// `[min, max]` of every macrocell of z-layer `k` into `out` (x fastest): per row of cells,
+/// the 9 × 9 lattice rows it touches reduced point by point along x (a loop the compiler
+/// vectorises), then each cell's 9 points along x. Reading the grid once per cell row instead
+/// of once per cell and row made the macrocells of ns740k at 4 voxels/Å (847 MB) 4× faster.
+fn layer<T: Value>(
+    v: &[T],
+    dims: [usize; 3],
+    cells: [usize; 2],
+    k: usize,
+    scale: f32,
+    out: &mut [f32],
+) {
+    let [nx, ny, nz] = dims;
+    let [cx, cy] = cells;
+    let (mut lo, mut hi) = (vec![T::TOP; nx], vec![T::BOTTOM; nx]);
+    let z0 = k * MACROCELL;
+    let z1 = (z0 + MACROCELL).min(nz - 1);
+    for j in 0..cy {
+        let y0 = j * MACROCELL;
+        let y1 = (y0 + MACROCELL).min(ny - 1);
+        lo.fill(T::TOP);
+        hi.fill(T::BOTTOM);
+        for z in z0..=z1 {
+            for y in y0..=y1 {
+                let row = &v[nx * (y + ny * z)..][..nx];
+                for ((l, h), &q) in lo.iter_mut().zip(hi.iter_mut()).zip(row) {
+                    *l = l.min(q);
+                    *h = h.max(q);
+                }
+            }
+        }
+        for i in 0..cx {
+            let x0 = i * MACROCELL;
+            let x1 = (x0 + MACROCELL).min(nx - 1);
+            let mn = lo[x0..=x1].iter().fold(T::TOP, |a, &q| a.min(q));
+            let mx = hi[x0..=x1].iter().fold(T::BOTTOM, |a, &q| a.max(q));
+            out[2 * (j * cx + i)] = mn.value(scale);
+            out[2 * (j * cx + i) + 1] = mx.value(scale);
+        }
+    }
 }

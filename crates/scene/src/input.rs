@@ -8,7 +8,8 @@ use molecule::read::{open_counted, Format, FrameIndex, ReadError, ReadOptions};
 use molecule::scenes::{try_generate, SceneName};
 use molecule::Molecule;
 
-use crate::build::{Progress, Stage, UnwrapReport};
+use crate::build::UnwrapReport;
+use crate::progress::{Progress, Stage};
 use crate::settings::BondSettings;
 use crate::SceneError;
 

@@ -19,11 +19,12 @@ mod input;
 mod memory;
 mod model;
 mod periodic;
+mod progress;
 mod report;
 mod settings;
 pub mod text;
 
-pub use build::{Density, DensityVolume, Prepared, Progress, Scene, Stage, Timings, UnwrapReport};
+pub use build::{Density, DensityVolume, Prepared, Scene, UnwrapReport};
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};
@@ -42,6 +43,7 @@ pub use memory::{
 };
 pub use model::{Coloring, Model, ModelOptions, Style, CELL_COLOR};
 pub use periodic::{add_cell_edges, split_periodic_sticks};
+pub use progress::{Progress, Stage, Timings};
 pub use settings::{
     BondSettings, BondSource, ColorBy, DensitySource, LightVolumeSettings, ModelSettings,
     RadiusKind, SceneSettings, VolumeSettings, LIGHT_VOLUME_STRIDE,

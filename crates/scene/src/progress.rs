@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use crate::SceneError;
 
-/// A stage of [`Scene::build`], reported to the progress callback when it starts.
+/// A stage of [`crate::Scene::build`], reported to the progress callback when it starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
     /// Bond detection.
@@ -44,7 +44,7 @@ impl std::fmt::Display for Stage {
     }
 }
 
-/// Where [`Scene::build_with`] reports progress: `stage` is called as each stage starts, with
+/// Where [`crate::Scene::build_with`] reports progress: `stage` is called as each stage starts, with
 /// the units of work the stage counts (atoms searched for bonds, primitives placed in the BVH,
 /// slab passes of the density, z-planes of the light volume, 1 for macrocells); the stage adds
 /// the units it finishes to `done`, which is set to 0 after `stage` returns (so `stage` still

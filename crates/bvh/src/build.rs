@@ -1,7 +1,7 @@
 //! BVH builders: binned SAH, parallel over subtrees (the fast one), and the paper's full-sweep
 //! SAH over presorted lists (§4.1, the quality reference).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
 use glam::Vec3A;
@@ -11,6 +11,9 @@ use crate::geometry::{prim_refs, prim_refs_as_records, Aabb, Geometry, PrimRecor
 use crate::tree::{refs_bounds, Builder, Bvh, Node, INNER, LEAF_MAX};
 
 mod cluster;
+mod watch;
+
+pub use watch::{Cancelled, Watch};
 
 /// Most bins the binned builder supports.
 pub const MAX_BINS: usize = 32;
@@ -456,7 +459,8 @@ pub(crate) enum Skeleton {
 
 /// Builds the tree over `refs` (primitive slots from `ref_base`): rayon over subtrees while
 /// both sides have at least [`PAR_SUBTREE`] primitives, then sequentially, adding the
-/// primitives of each finished sequential subtree to `done`.
+/// primitives of each finished sequential subtree to `watch`. Once `watch` is cancelled,
+/// subtrees not yet started are left as one empty node (the caller discards the tree).
 pub(crate) fn build_skeleton(
     refs: &mut [PrimRef],
     ref_base: usize,
@@ -464,17 +468,20 @@ pub(crate) fn build_skeleton(
     cb: Aabb,
     p: Params,
     pre: Option<Box<Binned>>,
-    done: &AtomicU64,
+    watch: &Watch,
 ) -> Skeleton {
     let n = refs.len();
+    if watch.check().is_err() {
+        return Skeleton::Local(vec![Node::default()]);
+    }
     if n >= 2 * PAR_SUBTREE {
         let (s, lpre, rpre) = split(refs, &cb, p, pre);
         let nl = s.nl;
         let (lrefs, rrefs) = refs.split_at_mut(nl);
         if nl >= PAR_SUBTREE && n - nl >= PAR_SUBTREE {
             let (l, r) = rayon::join(
-                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, p, lpre, done),
-                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, p, rpre, done),
+                || build_skeleton(lrefs, ref_base, s.lb, s.lcb, p, lpre, watch),
+                || build_skeleton(rrefs, ref_base + nl, s.rb, s.rcb, p, rpre, watch),
             );
             return Skeleton::Inner {
                 bounds,
@@ -491,13 +498,13 @@ pub(crate) fn build_skeleton(
         nodes.extend([root, Node::default(), Node::default()]);
         build_seq(lrefs, ref_base, s.lb, s.lcb, p, lpre, &mut nodes, 1);
         build_seq(rrefs, ref_base + nl, s.rb, s.rcb, p, rpre, &mut nodes, 2);
-        done.fetch_add(n as u64, Ordering::Relaxed);
+        watch.add(n);
         return Skeleton::Local(nodes);
     }
     let mut nodes = Vec::with_capacity(n);
     nodes.push(Node::default());
     build_seq(refs, ref_base, bounds, cb, p, pre, &mut nodes, 0);
-    done.fetch_add(n as u64, Ordering::Relaxed);
+    watch.add(n);
     Skeleton::Local(nodes)
 }
 
@@ -599,35 +606,58 @@ impl Bvh {
 
     /// Binned SAH build (§4.1 step 4, binned as in Wald 2007 instead of the paper's sweep).
     pub fn build_with(g: &Geometry, opt: &BuildOptions) -> Bvh {
-        Bvh::build_with_progress(g, opt, &AtomicU64::new(0))
+        match Bvh::build_watched(g, opt, None) {
+            Ok(b) => b,
+            Err(Cancelled) => unreachable!("an unwatched build is never cancelled"),
+        }
     }
 
-    /// [`Bvh::build_with`] adding to `done` the primitives placed in finished subtrees (it
-    /// reaches [`Geometry::prim_count`] when the tree is built), for a progress display that
-    /// reads it from another thread.
-    pub fn build_with_progress(g: &Geometry, opt: &BuildOptions, done: &AtomicU64) -> Bvh {
+    /// [`Bvh::build_with`] reporting to `watch`, if given: the primitives placed in finished
+    /// subtrees are added to its count (which reaches [`Geometry::prim_count`] when the tree
+    /// is built), and once its cancel test returns true the build stops after at most a few
+    /// thousand more primitives per thread and returns [`Cancelled`].
+    pub fn build_watched(
+        g: &Geometry,
+        opt: &BuildOptions,
+        watch: Option<&Watch>,
+    ) -> Result<Bvh, Cancelled> {
         let start = Instant::now();
+        let unwatched = AtomicU64::new(0);
+        let watch = watch.copied().unwrap_or(Watch {
+            done: &unwatched,
+            cancelled: &|| false,
+        });
         let nb = opt.bins.clamp(2, MAX_BINS);
         // One 32-byte array: the builder's references first, the records written over them
         // (the peak holds one of the two, not both).
         let n = g.prim_count();
         let (mut records, bounds, cb) = prim_refs_as_records(g);
+        watch.check()?;
         let refs: &mut [PrimRef] = bytemuck::cast_slice_mut(&mut records);
         let (nodes, order) = if n == 0 {
             (vec![Node::default()], Vec::new())
         } else if n > opt.cluster_above && n <= opt.cluster_upto {
-            cluster::build_clustered(refs, &cb, nb, LEAF_MAX, done)
+            cluster::build_clustered(refs, &cb, nb, LEAF_MAX, &watch)?
         } else {
             let p = Params {
                 nb,
                 leaf_max: LEAF_MAX,
                 small: SMALL,
             };
-            let sk = build_skeleton(refs, 0, bounds, cb, p, None, done);
+            let sk = build_skeleton(refs, 0, bounds, cb, p, None, &watch);
+            watch.check()?;
             let order = refs.par_iter().with_min_len(4096).map(|r| r.id()).collect();
             (assemble(sk), order)
         };
-        Bvh::finish(g, nodes, order, records, Builder::Binned, start)
+        watch.check()?;
+        Ok(Bvh::finish(
+            g,
+            nodes,
+            order,
+            records,
+            Builder::Binned,
+            start,
+        ))
     }
 
     /// The paper's builder (§4.1): primitives presorted along x, y and z; each node sweeps all

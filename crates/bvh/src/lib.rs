@@ -28,7 +28,7 @@ mod tree;
 mod wide;
 
 pub use beam::{Corners, Frusta, Origin};
-pub use build::{BuildOptions, CLUSTER_ABOVE, CLUSTER_UPTO, MAX_BINS};
+pub use build::{BuildOptions, Cancelled, Watch, CLUSTER_ABOVE, CLUSTER_UPTO, MAX_BINS};
 pub use geometry::{Aabb, Balls, Geometry, Prim, PrimRecord, Sticks};
 pub use intersect::{
     end_point, intersect_ball, intersect_bond, intersect_record, ray_bond, ray_cap, ray_cylinder,

@@ -180,3 +180,59 @@ fn huge_and_tiny_coordinates() {
         check(&g);
     }
 }
+
+/// A watched build (the viewer's loader stops one the user has stepped past): never
+/// cancelled, it is the plain build and counts every primitive once; cancelled before it
+/// starts, it builds nothing; cancelled after its first finished piece, on one thread, it
+/// places no more than that piece — per-primitive and clustered builds alike.
+#[test]
+fn a_watched_build_counts_every_primitive_and_stops_when_cancelled() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    // 20K primitives stay below CLUSTER_ABOVE; 120K atoms' ~200K primitives are clustered.
+    for (atoms, opt) in [
+        (10_000, BuildOptions::default()),
+        (120_000, BuildOptions::default()),
+        (120_000, per_primitive()),
+    ] {
+        let g = random_molecule(atoms, false, 9);
+        let n = g.prim_count() as u64;
+        let plain = Bvh::build_with(&g, &opt);
+        let label = format!("{n} primitives, {:?}", opt.cluster_above);
+        let done = AtomicU64::new(0);
+        let never = bvh::Watch {
+            done: &done,
+            cancelled: &|| false,
+        };
+        let watched = Bvh::build_watched(&g, &opt, Some(&never)).unwrap();
+        watched.validate(&g).unwrap();
+        assert_eq!(watched.nodes, plain.nodes, "{label}");
+        assert_eq!(watched.prim_ids, plain.prim_ids, "{label}");
+        assert_eq!(done.load(Ordering::Relaxed), n, "{label}");
+
+        let done = AtomicU64::new(0);
+        let at_once = bvh::Watch {
+            done: &done,
+            cancelled: &|| true,
+        };
+        let r = Bvh::build_watched(&g, &opt, Some(&at_once));
+        assert_eq!(r.err(), Some(bvh::Cancelled), "{label}");
+        assert_eq!(done.load(Ordering::Relaxed), 0, "{label}");
+
+        let done = AtomicU64::new(0);
+        let after_one = || done.load(Ordering::Relaxed) > 0;
+        let watch = bvh::Watch {
+            done: &done,
+            cancelled: &after_one,
+        };
+        let r = one.install(|| Bvh::build_watched(&g, &opt, Some(&watch)));
+        assert_eq!(r.err(), Some(bvh::Cancelled), "{label}");
+        let placed = done.load(Ordering::Relaxed);
+        // One piece: a clustered group (≤ 16 clusters of ≤ 128) or a sequential subtree
+        // (< 2 × 4096 primitives, or a lopsided split's whole node below the top).
+        assert!(placed > 0 && placed < n / 2, "{label}: placed {placed}");
+    }
+}

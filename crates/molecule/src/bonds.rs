@@ -398,7 +398,10 @@ pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
         return Vec::new();
     }
     let grid = Grid::build(&rule);
-    collect_bonds(&rule, &grid, &AtomicU64::new(0))
+    match collect_bonds(&rule, &grid, &AtomicU64::new(0), &|| false) {
+        Some(bonds) => bonds,
+        None => unreachable!("a search without a cancel test is never cancelled"),
+    }
 }
 
 /// [`build_bonds`] with limits, for untrusted input: refuses (before any large allocation)
@@ -407,15 +410,18 @@ pub fn build_bonds(m: &Molecule, opts: &BondOptions) -> Vec<[u32; 2]> {
 /// candidate pairs exceeds [`max_candidate_pairs`] ([`BondError::TooMany`]); the output is
 /// reserved with `try_reserve` ([`BondError::Alloc`]). Same bonds as [`build_bonds`] otherwise.
 pub fn try_build_bonds(m: &Molecule, opts: &BondOptions) -> Result<Vec<[u32; 2]>, BondError> {
-    try_build_bonds_with_progress(m, opts, &AtomicU64::new(0))
+    try_build_bonds_with_progress(m, opts, &AtomicU64::new(0), &|| false)
 }
 
 /// [`try_build_bonds`] adding to `done` the atoms whose neighbours have been searched (up to
-/// the atom count), for a progress display that reads it from another thread.
+/// the atom count), for a progress display that reads it from another thread, and asking
+/// `cancelled` before each chunk of 4096 atoms: once it returns true the search skips the
+/// chunks left and returns [`BondError::Cancelled`].
 pub fn try_build_bonds_with_progress(
     m: &Molecule,
     opts: &BondOptions,
     done: &AtomicU64,
+    cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<[u32; 2]>, BondError> {
     let n = m.len();
     if n < 2 {
@@ -446,7 +452,10 @@ pub fn try_build_bonds_with_progress(
             bytes: estimate.min(16 * n as u64) * 8,
         })?;
     drop(probe);
-    Ok(collect_bonds(&rule, &grid, done))
+    if cancelled() {
+        return Err(BondError::Cancelled);
+    }
+    collect_bonds(&rule, &grid, done, cancelled).ok_or(BondError::Cancelled)
 }
 
 /// Largest grid extent, in units of the largest cutoff, that [`try_build_bonds`] accepts
@@ -497,6 +506,9 @@ pub enum BondError {
         /// Largest bond cutoff (Å).
         cutoff: f32,
     },
+    /// The search was cancelled by its caller (a newer request made it pointless).
+    #[error("the bond search was cancelled")]
+    Cancelled,
     /// The bond list could not be allocated.
     #[error("cannot allocate {bytes} bytes for bonds; pass --bonds none or a smaller cutoff")]
     Alloc {
@@ -539,25 +551,37 @@ fn check_extent(m: &Molecule, cut: f32) -> Result<(), BondError> {
 }
 
 /// Bonds from a built grid (the parallel neighbour search of [`build_bonds`]), adding each
-/// searched chunk's atoms to `done`.
-fn collect_bonds(rule: &Rule<'_>, grid: &Grid, done: &AtomicU64) -> Vec<[u32; 2]> {
+/// searched chunk's atoms to `done`; `None` when `cancelled` returned true (chunks not yet
+/// started are skipped).
+fn collect_bonds(
+    rule: &Rule<'_>,
+    grid: &Grid,
+    done: &AtomicU64,
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Option<Vec<[u32; 2]>> {
     let n = rule.m.len();
     const CHUNK: usize = 4096;
     let chunks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
+            if cancelled() {
+                return Vec::new();
+            }
             let atoms = c * CHUNK..((c + 1) * CHUNK).min(n);
             let out = chunk_bonds(rule, grid, atoms.clone());
             done.fetch_add(atoms.len() as u64, Ordering::Relaxed);
             out
         })
         .collect();
+    if cancelled() {
+        return None;
+    }
     let total = chunks.iter().map(Vec::len).sum();
     let mut out = Vec::with_capacity(total);
     for c in chunks {
         out.extend_from_slice(&c);
     }
-    out
+    Some(out)
 }
 
 /// The bonds `[i, j]` with `i` in `atoms` and `j > i`, sorted: each atom's neighbour cells

@@ -119,3 +119,38 @@ fn min_distance_excludes_overlaps() {
         vec![[0, 2], [1, 2]]
     );
 }
+
+/// The search a viewer's loader stops when the user steps past its frame: never cancelled it
+/// is the plain search and counts every atom; cancelled before it starts it searches
+/// nothing; cancelled after its first chunk of 4096 atoms, on one thread, it searches no
+/// other chunk.
+#[test]
+fn a_cancelled_bond_search_stops_after_the_chunk_in_hand() {
+    use molecule::bonds::{try_build_bonds_with_progress, BondError};
+    use molecule::scenes::{generate, SceneName};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let m = generate(SceneName::Ns90k, Some(20_000), 1);
+    let n = m.len() as u64;
+    let opts = BondOptions::default();
+    let done = AtomicU64::new(0);
+    let all = try_build_bonds_with_progress(&m, &opts, &done, &|| false).unwrap();
+    assert_eq!(all, build_bonds(&m, &opts));
+    assert_eq!(done.load(Ordering::Relaxed), n);
+    assert!(n > 3 * 4096, "{n} atoms");
+
+    let done = AtomicU64::new(0);
+    let r = try_build_bonds_with_progress(&m, &opts, &done, &|| true);
+    assert!(matches!(r, Err(BondError::Cancelled)), "{r:?}");
+    assert_eq!(done.load(Ordering::Relaxed), 0);
+    assert!(r.unwrap_err().to_string().contains("cancelled"));
+
+    let done = AtomicU64::new(0);
+    let after_one = || done.load(Ordering::Relaxed) > 0;
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let r = one.install(|| try_build_bonds_with_progress(&m, &opts, &done, &after_one));
+    assert!(matches!(r, Err(BondError::Cancelled)), "{r:?}");
+    assert_eq!(done.load(Ordering::Relaxed), 4096);
+}

@@ -9,7 +9,7 @@ use render::{render_frame, Camera, FrameInputs, Framebuffer, Model, RenderSettin
 use spmd::Isa;
 
 fn render(c: &mut Criterion) {
-    let scene = Model::from_geometry(random_molecule(100_000, false, 7), None);
+    let scene = Model::from_geometry(random_molecule(100_000, false, 7), None).unwrap();
     let cam = Camera::view(View::Far, scene.center, scene.radius, 45.0, 1.0);
     let mut fb = Framebuffer::new(512, 512, 0).unwrap();
     let ro = RenderSettings::default();

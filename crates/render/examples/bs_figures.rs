@@ -30,7 +30,7 @@ fn main() {
         let b = Bvh::build(&g);
         best = best.min(b.stats.build_time.as_secs_f64());
     }
-    let scene = Model::from_geometry(g, None);
+    let scene = Model::from_geometry(g, None).unwrap();
     let st = scene.bvh.stats;
     println!(
         "BVH {} prims ({} atoms): best of 3 {:.1} ms = {:.2} M prims/s; {} nodes, depth {}, SAH {:.2}, {:.1} bytes/atom",

@@ -15,7 +15,7 @@ fn main() {
         Some(r) => vec![r.parse().unwrap()],
         None => vec![1, 2, 4],
     };
-    let scene = Model::from_geometry(random_molecule(atoms, false, 7), None);
+    let scene = Model::from_geometry(random_molecule(atoms, false, 7), None).unwrap();
     let mut fb = Framebuffer::new(1024, 1024, 0).unwrap();
     // Configurations are interleaved frame by frame so load from other processes hits them
     // alike; min and median per configuration.

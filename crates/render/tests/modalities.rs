@@ -49,7 +49,7 @@ fn balls(centres: &[[f32; 3]], radius: &[f32], color: &[u32]) -> Model {
         show_balls: true,
         capped: false,
     };
-    Model::from_geometry(g, None)
+    Model::from_geometry(g, None).unwrap()
 }
 
 /// A 21×21 slab of overlapping unit balls in the plane y = 0 (spacing 1 Å, so its top is a
@@ -385,6 +385,7 @@ fn molecule_scene() -> Model {
         &render::ModelOptions::default(),
         None,
     )
+    .unwrap()
 }
 
 /// Fraction of pixels whose channels all lie within `tol` of the reference, and the mean

@@ -43,7 +43,8 @@ fn every_backend_matches_scalar() {
             &pairs(&g),
             &opt,
             None,
-        );
+        )
+        .unwrap();
         scene.bvh.validate(&scene.geometry).unwrap();
         for view in [View::Far, View::Close] {
             let (w, h) = (203, 150);
@@ -106,7 +107,7 @@ fn sphere_and_cylinder() -> Model {
         show_balls: true,
         capped: false,
     };
-    Model::from_geometry(g, None)
+    Model::from_geometry(g, None).unwrap()
 }
 
 #[test]
@@ -231,7 +232,8 @@ fn scalar_colormap_and_png() {
         &pairs(&g),
         &opt,
         None,
-    );
+    )
+    .unwrap();
     assert_eq!(scene.geometry.balls.color[0], rgba(68, 1, 84, 255));
     assert_eq!(scene.geometry.balls.color[499], rgba(253, 231, 37, 255));
     let cam = Camera::view(View::Far, scene.center, scene.radius, 45.0, 1.0);

@@ -104,7 +104,8 @@ fn protein_renders_alike_on_every_backend() {
             &bonds,
             &opt,
             None,
-        );
+        )
+        .unwrap();
         scene.bvh.validate(&scene.geometry).unwrap();
         for view in [View::Far, View::Close] {
             let cam = Camera::view(view, scene.center, scene.radius, 40.0, 1.25);

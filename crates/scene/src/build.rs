@@ -2,10 +2,10 @@
 //! with its BVH, the density volume with macrocells and classified transfer function, and the
 //! light volume (paper §4.1 steps 3-5), with per-stage timings and a memory check first.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use molecule::bonds::{try_build_bonds_with_progress, BondOptions};
+use molecule::bonds::{try_build_bonds_with_progress, BondError, BondOptions};
 use molecule::unwrap::{crosses, unwrap, UnwrapError, UnwrapMethod};
 use molecule::{elements, MinimumImage, Molecule};
 use spmd::Isa;
@@ -187,7 +187,7 @@ impl Scene {
             keep_crossing,
             m,
             &mut self.bonds,
-            &progress.done,
+            progress,
         )?;
         self.timings.bonds = t.elapsed().as_secs_f64();
         // From here on the frame is the unwrapped one (model, volume, camera sphere).
@@ -219,7 +219,7 @@ impl Scene {
             let prims = model_prim_count(m.len(), self.bonds.len(), ms).1;
             progress.start(Stage::Model, prims as u64)?;
             let t = Instant::now();
-            let model = build_model(m, &self.bonds, ms, &mut self.scratch, &progress.done)?;
+            let model = build_model(m, &self.bonds, ms, &mut self.scratch, progress)?;
             if ms.wide_bvh {
                 model.wide();
             }
@@ -411,7 +411,7 @@ impl BondSettings {
     /// that still cross the cell after unwrapping ([`ModelSettings::periodic_bonds`]).
     pub fn prepare(&self, m: &Molecule, keep_crossing: bool) -> Result<Prepared, SceneError> {
         let mut bonds = Vec::new();
-        let u = prepare_into(self, true, keep_crossing, m, &mut bonds, &AtomicU64::new(0))?;
+        let u = prepare_into(self, true, keep_crossing, m, &mut bonds, &Progress::none())?;
         let (unwrapped, unwrap) = match u {
             Some((m, r)) => (Some(m), Some(r)),
             None => (None, None),
@@ -475,11 +475,11 @@ fn prepare_into(
     keep_crossing: bool,
     m: &Molecule,
     out: &mut Vec<[u32; 2]>,
-    done: &AtomicU64,
+    progress: &Progress,
 ) -> Result<Option<(Molecule, UnwrapReport)>, SceneError> {
     if !b.unwrap {
         if draw {
-            fill_bonds(b, m, out, done)?;
+            fill_bonds(b, m, out, progress)?;
         } else {
             out.clear();
         }
@@ -501,7 +501,7 @@ fn prepare_into(
             },
             unwrap: false,
         };
-        fill_bonds(&pbc, m, out, done)?;
+        fill_bonds(&pbc, m, out, progress)?;
     }
     let mut u = m.clone();
     unwrap(&mut u, out)?;
@@ -524,15 +524,26 @@ fn prepare_into(
     Ok(Some((u, report)))
 }
 
-/// Replaces `out` with the bonds of `m` (adding the atoms searched to `done`).
+/// Replaces `out` with the bonds of `m` (adding the atoms searched to `progress`, and
+/// stopping with [`SceneError::Cancelled`] once it is cancelled).
 fn fill_bonds(
     b: &BondSettings,
     m: &Molecule,
     out: &mut Vec<[u32; 2]>,
-    done: &AtomicU64,
+    progress: &Progress,
 ) -> Result<(), SceneError> {
     match b.source {
-        BondSource::Auto => *out = try_build_bonds_with_progress(m, &b.options, done)?,
+        BondSource::Auto => {
+            *out = match try_build_bonds_with_progress(
+                m,
+                &b.options,
+                &progress.done,
+                progress.cancelled,
+            ) {
+                Err(BondError::Cancelled) => return Err(SceneError::Cancelled),
+                r => r?,
+            }
+        }
         BondSource::File => {
             let fb = m.file_bonds.as_ref().ok_or(SceneError::NoFileBonds)?;
             out.clear();
@@ -561,7 +572,7 @@ pub(crate) fn build_model(
     bonds: &[[u32; 2]],
     ms: &ModelSettings,
     scratch: &mut (Vec<f32>, Vec<u32>),
-    done: &AtomicU64,
+    progress: &Progress,
 ) -> Result<Model, SceneError> {
     check_model(ms)?;
     let (radius, colors) = scratch;
@@ -613,16 +624,12 @@ pub(crate) fn build_model(
     if ms.draw_cell && m.cell.is_none() {
         return Err(SceneError::NoCell);
     }
-    Ok(Model::new(
-        &m.x,
-        &m.y,
-        &m.z,
-        radius,
-        colors,
-        bonds,
-        &opt,
-        Some(done),
-    ))
+    let watch = bvh::Watch {
+        done: &progress.done,
+        cancelled: progress.cancelled,
+    };
+    Model::new(&m.x, &m.y, &m.z, radius, colors, bonds, &opt, Some(&watch))
+        .map_err(|bvh::Cancelled| SceneError::Cancelled)
 }
 
 impl ModelSettings {
@@ -633,7 +640,7 @@ impl ModelSettings {
             bonds,
             self,
             &mut (Vec::new(), Vec::new()),
-            &AtomicU64::new(0),
+            &Progress::none(),
         )
     }
 }

@@ -1,9 +1,8 @@
 //! Model assembly: styles, radii, colours, BVH.
 
-use std::sync::atomic::AtomicU64;
 use std::sync::OnceLock;
 
-use bvh::{Balls, BuildOptions, Bvh, Geometry, Prim, WideBvh};
+use bvh::{Balls, BuildOptions, Bvh, Cancelled, Geometry, Prim, Watch, WideBvh};
 use rayon::prelude::*;
 
 use molecule::Cell;
@@ -103,8 +102,9 @@ impl Model {
     /// Builds a scene from atom positions (Å), per-atom base radius (Å, scaled by
     /// `opt.radius_scale`), per-atom colours (packed RGBA8, see [`crate::rgba`]) and bonds.
     /// Bonds with an atom index out of range are ignored. `colors` may be empty (grey).
-    /// `done`, if given, counts the primitives the BVH builder has placed (see
-    /// [`Model::from_geometry`]), for a progress display.
+    /// `watch`, if given, counts the primitives the BVH builder has placed (see
+    /// [`Model::from_geometry`]), for a progress display, and can stop the build
+    /// ([`Cancelled`]; never without a watch).
     /// Panics if `x`, `y`, `z` and `radius` differ in length.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -115,8 +115,8 @@ impl Model {
         colors: &[u32],
         bonds: &[[u32; 2]],
         opt: &ModelOptions,
-        done: Option<&AtomicU64>,
-    ) -> Model {
+        watch: Option<&Watch>,
+    ) -> Result<Model, Cancelled> {
         let n = x.len();
         let radii: Vec<f32> = radius.iter().map(|r| r * opt.radius_scale).collect();
         let mut color_range = None;
@@ -177,19 +177,18 @@ impl Model {
                 add_cell_edges(&mut g, cell, CELL_COLOR);
             }
         }
-        let mut m = Model::from_geometry(g, done);
+        let mut m = Model::from_geometry(g, watch)?;
         m.color_range = color_range;
-        m
+        Ok(m)
     }
 
     /// Builds the BVH and colour tables for ready-made geometry (colours from
-    /// `g.balls.color`, grey where missing). `done`, if given, counts the primitives the BVH
+    /// `g.balls.color`, grey where missing). `watch`, if given, counts the primitives the BVH
     /// builder has placed in finished subtrees (up to `g.prim_count()`), for a progress
-    /// display that reads it from another thread.
-    pub fn from_geometry(g: Geometry, done: Option<&AtomicU64>) -> Model {
-        let unwatched = AtomicU64::new(0);
-        let done = done.unwrap_or(&unwatched);
-        let bvh = Bvh::build_with_progress(&g, &BuildOptions::default(), done);
+    /// display that reads it from another thread, and can stop the build
+    /// ([`Bvh::build_watched`]; never cancelled without a watch).
+    pub fn from_geometry(g: Geometry, watch: Option<&Watch>) -> Result<Model, Cancelled> {
+        let bvh = Bvh::build_watched(&g, &BuildOptions::default(), watch)?;
         let color = |end: u32| -> i32 {
             g.endpoint_color(end)
                 .unwrap_or(crate::rgba(200, 200, 200, 255)) as i32
@@ -245,7 +244,7 @@ impl Model {
             });
             (c, (r.max(r_ends) as f32).max(1e-3))
         };
-        Model {
+        Ok(Model {
             geometry: g,
             bvh,
             slot_color_a,
@@ -254,7 +253,7 @@ impl Model {
             radius,
             color_range: None,
             wide: OnceLock::new(),
-        }
+        })
     }
 
     /// The 8-wide BVH of secondary rays ((`render::SecondaryTraversal::Wide`)), built from

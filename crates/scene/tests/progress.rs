@@ -1,7 +1,8 @@
 //! Scene::build_with's progress: every stage that starts is announced with its units of work,
 //! and its counter ends exactly there (so a bar reaches 100 % and never passes it), for both
 //! volume formats and with unwrapping; the scene is the same as without progress. A build
-//! whose cancel test turns true stops at the next stage or slab pass with `Cancelled`.
+//! whose cancel test turns true stops at the next stage, slab pass, chunk of the bond search
+//! or piece of the BVH with `Cancelled`.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -185,7 +186,7 @@ fn a_cancelled_build_stops_at_the_next_stage() {
     let (r, seen, _) = build_until(&m, &st, |_, _| true);
     assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
     assert!(seen.is_empty(), "{seen:?}");
-    // Cancelled once the BVH has started: the BVH finishes, the volume never starts.
+    // Cancelled once the BVH has started: the volume never starts.
     let (r, seen, _) = build_until(&m, &st, |s, _| s == Some(Stage::Model));
     assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
     assert_eq!(seen, [Stage::Bonds, Stage::Model]);
@@ -195,6 +196,40 @@ fn a_cancelled_build_stops_at_the_next_stage() {
     let (r, seen, _) = build_until(&m, &st, |_, _| false);
     assert!(r.is_ok());
     assert_eq!(seen.len(), 5, "{seen:?}");
+}
+
+#[test]
+fn a_build_cancelled_inside_the_bond_search_or_the_bvh_skips_the_rest_of_it() {
+    // 30K atoms: 8 chunks of the bond search; ~75K primitives, a clustered BVH.
+    let m = generate(SceneName::Ns90k, Some(30_000), 1);
+    let st = SceneSettings {
+        volume: None,
+        ..settings(VolumeFormat::U8, false)
+    };
+    let prims = Scene::build(Isa::Scalar, &m, &st)
+        .unwrap()
+        .model
+        .unwrap()
+        .bvh
+        .stats
+        .prims as u64;
+    assert!(prims as usize > bvh::CLUSTER_ABOVE, "{prims}");
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    // Cancelled as soon as the stage has finished some work: on one thread it stops
+    // after that piece (a chunk of 4096 atoms; a group of clusters), not at the stage's end.
+    for (stage, total) in [(Stage::Bonds, m.len() as u64), (Stage::Model, prims)] {
+        let stop = |s: Option<Stage>, done: u64| s == Some(stage) && done >= 1;
+        let (r, seen, counted) = one.install(|| build_until(&m, &st, stop));
+        assert!(matches!(r, Err(SceneError::Cancelled)), "{:?}", r.err());
+        assert_eq!(seen.last(), Some(&stage));
+        assert!(
+            counted >= 1 && counted <= total / 4,
+            "{stage}: {counted} of {total}"
+        );
+    }
 }
 
 #[test]

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd};
 
 use crate::VolumeError;
+pub use bvh::Watch;
 
 /// How voxel values are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -311,16 +312,6 @@ pub fn density_work(dims: [usize; 3], format: VolumeFormat) -> u64 {
     dims[2].div_ceil(SLAB) as u64 * passes
 }
 
-/// Who watches a density build from another thread.
-pub struct Watch<'a> {
-    /// Gains one per finished slab pass (up to [`density_work`]), for a progress display.
-    pub done: &'a AtomicU64,
-    /// Asked before each slab pass: once it returns true, the remaining passes are skipped
-    /// and the build returns [`VolumeError::Cancelled`] (a caller whose result is no longer
-    /// wanted gets its cores back within a fraction of a second).
-    pub cancelled: &'a (dyn Fn() -> bool + Sync),
-}
-
 /// Builds the density volume of the atoms (positions `x, y, z` and covalent radii `r`, Å)
 /// on [`Grid::for_atoms`] at `params.voxels_per_angstrom`, using backend `isa`.
 ///
@@ -336,7 +327,10 @@ pub struct Watch<'a> {
 /// resolution) when [`estimate_bytes`] exceeds the budget or the voxel count exceeds what
 /// 32-bit gather indices can address.
 ///
-/// `watch`, if given, counts the finished slab passes and can stop the build ([`Watch`]).
+/// `watch`, if given, counts the finished slab passes (up to [`density_work`]) and is asked
+/// before each slab pass: once it is cancelled the remaining passes are skipped and the build
+/// returns [`VolumeError::Cancelled`] (a caller whose result is no longer wanted gets its
+/// cores back within a fraction of a second).
 pub fn build_density(
     isa: Isa,
     x: &[f32],

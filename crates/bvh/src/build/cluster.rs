@@ -8,12 +8,12 @@
 //! price: the groups' nodes exist twice while they are copied into the tree (the
 //! per-primitive build frees its subtrees as it copies them).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 use glam::Vec3A;
 use rayon::prelude::*;
 
-use super::{assemble, build_seq, build_skeleton, Params};
+use super::{assemble, build_seq, build_skeleton, Cancelled, Params, Watch};
 use crate::geometry::{Aabb, PrimRef};
 use crate::tree::Node;
 
@@ -107,10 +107,12 @@ pub(crate) fn build_clustered(
     cb: &Aabb,
     nb: usize,
     leaf_max: usize,
-    done: &AtomicU64,
-) -> (Vec<Node>, Vec<u32>) {
+    watch: &Watch,
+) -> Result<(Vec<Node>, Vec<u32>), Cancelled> {
     let mut keys = morton_keys(refs, cb);
+    watch.check()?;
     keys.par_sort_unstable();
+    watch.check()?;
     let mut runs = Vec::with_capacity(2 * refs.len() / CLUSTER_MAX + 1);
     cut(&keys, 0, keys.len(), 3 * MORTON_BITS, &mut runs);
     // The references in Morton order: cluster c is `sorted[runs[c].0..runs[c].1]`.
@@ -147,8 +149,12 @@ pub(crate) fn build_clustered(
         top_cb,
         top,
         None,
-        &AtomicU64::new(0),
+        &Watch {
+            done: &AtomicU64::new(0),
+            cancelled: watch.cancelled,
+        },
     );
+    watch.check()?;
     let top_nodes = assemble(sk);
 
     // The top tree's leaves (runs of `crefs`) in slot order, and the first slot of each.
@@ -178,6 +184,9 @@ pub(crate) fn build_clustered(
         .par_iter()
         .zip(bases.par_iter())
         .map(|(&(f, c), &base)| {
+            if watch.check().is_err() {
+                return (Vec::new(), Vec::new());
+            }
             let mut local: Vec<PrimRef> = Vec::new();
             for r in &crefs[f..f + c] {
                 let (lo, hi) = runs[r.id() as usize];
@@ -191,11 +200,12 @@ pub(crate) fn build_clustered(
             let mut nodes = Vec::with_capacity(local.len());
             nodes.push(Node::default());
             build_seq(&mut local, base, b, cb, inner, None, &mut nodes, 0);
-            done.fetch_add(local.len() as u64, Ordering::Relaxed);
+            watch.add(local.len());
             (nodes, local.iter().map(|r| r.id()).collect())
         })
         .collect();
     drop(sorted);
+    watch.check()?;
     let (subs, ids): (Vec<Vec<Node>>, Vec<Vec<u32>>) = subs.into_iter().unzip();
     let order = ids.concat();
     drop(ids);
@@ -220,7 +230,7 @@ pub(crate) fn build_clustered(
         .collect();
     let (root, rest) = out.split_first_mut().expect("one node at least");
     splice(&top, 0, &below, root, rest, 1);
-    (out, order)
+    Ok((out, order))
 }
 
 /// The top tree over the clusters, and the subtree that replaces each of its leaves (by the

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use molecule::read::{FrameIndex, Trajectory};
+use molecule::read::{CancelTest, FrameIndex, ReadError, Trajectory};
 use molecule::Molecule;
 use scene::{Progress, Scene, SceneError, SceneSettings};
 use spmd::Isa;
@@ -54,10 +54,15 @@ impl FrameSource {
         }
     }
 
-    fn read(&mut self, k: usize) -> Result<Molecule, String> {
+    /// Time step `k`; a file's read stops once `cancel` returns true (`Ok(None)`).
+    fn read(&mut self, k: usize, cancel: CancelTest) -> Result<Option<Molecule>, String> {
         match self {
-            FrameSource::File(t) => t.read_frame(k).map_err(|e| e.to_string()),
-            FrameSource::One(m, _) if k == 0 => Ok((**m).clone()),
+            FrameSource::File(t) => match t.read_frame_unless(k, cancel) {
+                Ok(m) => Ok(Some(m)),
+                Err(ReadError::Cancelled { .. }) => Ok(None),
+                Err(e) => Err(e.to_string()),
+            },
+            FrameSource::One(m, _) if k == 0 => Ok(Some((**m).clone())),
             FrameSource::One(_, n) => Err(format!("{n}: has one frame, no frame {k}")),
         }
     }
@@ -207,8 +212,9 @@ fn yield_to_the_window() {
 }
 
 /// The loader thread: the newest request first (older waiting ones are answered as
-/// skipped), read, build on the loader's own pool (stopped as soon as a newer request is
-/// made: answered as cancelled), send.
+/// skipped), read and build on the loader's own pool (both stopped as soon as a newer
+/// request is made — the read within a megabyte of input, the build within a slab pass, a
+/// chunk of the bond search or a piece of the BVH — and answered as cancelled), send.
 fn serve(
     mut source: FrameSource,
     isa: Isa,
@@ -233,10 +239,19 @@ fn serve(
             r = newer;
         }
         let t0 = Instant::now();
-        let m = source.read(r.frame);
+        let (wanted, id) = (newest.clone(), r.id);
+        let m = source.read(
+            r.frame,
+            Arc::new(move || wanted.load(Ordering::Relaxed) != id),
+        );
         let read_s = t0.elapsed().as_secs_f64();
         let t = Instant::now();
         let stale = || newest.load(Ordering::Relaxed) != r.id;
+        let cancelled = || Answer::Cancelled {
+            id: r.id,
+            frame: r.frame,
+            spent_s: t0.elapsed().as_secs_f64(),
+        };
         let done = |scene: Result<Scene, String>| Answer::Built {
             id: r.id,
             frame: r.frame,
@@ -245,7 +260,8 @@ fn serve(
             build_s: t.elapsed().as_secs_f64(),
         };
         let answer = match m {
-            Ok(m) => {
+            Ok(None) => cancelled(),
+            Ok(Some(m)) => {
                 let build = || {
                     let progress = Progress {
                         cancelled: &stale,
@@ -254,11 +270,7 @@ fn serve(
                     Scene::build_with(isa, &m, &r.settings, &progress)
                 };
                 match pool.as_ref().map_or_else(|_| build(), |p| p.install(build)) {
-                    Err(SceneError::Cancelled) => Answer::Cancelled {
-                        id: r.id,
-                        frame: r.frame,
-                        spent_s: t0.elapsed().as_secs_f64(),
-                    },
+                    Err(SceneError::Cancelled) => cancelled(),
                     scene => done(scene.map_err(|e| e.to_string())),
                 }
             }
@@ -285,6 +297,38 @@ mod tests {
     use spmd::Isa;
 
     use super::*;
+
+    #[test]
+    fn a_cancelled_read_is_no_error_and_the_step_is_read_again_in_full() {
+        let dir = std::env::temp_dir().join(format!("bns_loader_read_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("two.xyz");
+        let mut text = Vec::new();
+        for k in 0..2 {
+            let mut m = generate(SceneName::Nanobowl, Some(2000), 1);
+            m.x.iter_mut().for_each(|x| *x += k as f32);
+            molecule::write::write_xyz(&mut text, &m, "").unwrap();
+        }
+        std::fs::write(&path, &text).unwrap();
+        let input = scene::Input::File {
+            path: path.clone(),
+            options: Default::default(),
+        };
+        let (mut source, first) = FrameSource::open(&input, 0).unwrap();
+        assert_eq!(first, 0);
+        // Stopped: no molecule and no error (the loader answers "cancelled").
+        assert!(matches!(source.read(1, Arc::new(|| true)), Ok(None)));
+        let m = source.read(1, Arc::new(|| false)).unwrap().unwrap();
+        let want = molecule::read::read_first(&path, &Default::default()).unwrap();
+        assert_eq!(m.len(), want.len());
+        assert!(
+            m.x.iter().zip(&want.x).all(|(a, b)| a - b == 1.0),
+            "frame 1"
+        );
+        let again = source.read(1, Arc::new(|| false)).unwrap().unwrap();
+        assert!((m.x, m.y, m.z) == (again.x, again.y, again.z));
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn a_newer_request_stops_the_build_in_progress() {

@@ -23,7 +23,13 @@ pub(crate) struct LineReader {
     pub(crate) path: Arc<Path>,
     /// Frame being read (for error messages).
     pub(crate) frame: usize,
+    /// Asked before each refill of the buffer: true stops the read with
+    /// [`ReadError::Cancelled`].
+    pub(crate) cancel: Option<CancelTest>,
 }
+
+/// A caller's test of whether the frame being read is still wanted (true: stop).
+pub type CancelTest = Arc<dyn Fn() -> bool + Send + Sync>;
 
 impl LineReader {
     pub(crate) fn new(src: Box<dyn Read + Send>, path: Arc<Path>) -> LineReader {
@@ -38,6 +44,7 @@ impl LineReader {
             offset: 0,
             path,
             frame: 0,
+            cancel: None,
         }
     }
 
@@ -59,6 +66,11 @@ impl LineReader {
     }
 
     fn fill(&mut self) -> Result<(), ReadError> {
+        if self.cancel.as_ref().is_some_and(|c| c()) {
+            return Err(ReadError::Cancelled {
+                path: self.path.to_path_buf(),
+            });
+        }
         if self.pos > 0 {
             self.buf.copy_within(self.pos..self.end, 0);
             self.end -= self.pos;

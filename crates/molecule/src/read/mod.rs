@@ -18,6 +18,7 @@ mod pdb;
 mod xyz;
 
 pub use follow::{FollowError, Follower};
+pub use lex::CancelTest;
 pub(crate) use lex::LineReader;
 
 use crate::Molecule;
@@ -194,6 +195,12 @@ pub enum ReadError {
         back: usize,
         /// Number of frames in the file.
         count: usize,
+    },
+    /// The caller stopped the read ([`Trajectory::read_frame_unless`]).
+    #[error("{}: reading cancelled", .path.display())]
+    Cancelled {
+        /// File being read.
+        path: PathBuf,
     },
     /// `read_frame(k)` past the end.
     #[error("{}: frame {frame} does not exist (the file has {count} frame(s))", .path.display())]
@@ -462,6 +469,7 @@ pub fn open_counted(
         tail_warning: None,
         all_warnings: Vec::new(),
         decoded,
+        cancel: None,
     })
 }
 
@@ -500,6 +508,8 @@ pub struct Trajectory {
     all_warnings: Vec<String>,
     /// Bytes decoded from the file so far, over every pass ([`Trajectory::decoded_bytes`]).
     decoded: Arc<AtomicU64>,
+    /// The cancel test of the read in progress ([`Trajectory::read_frame_unless`]).
+    cancel: Option<CancelTest>,
 }
 
 impl Trajectory {
@@ -608,6 +618,27 @@ impl Trajectory {
         Ok(self.count.unwrap_or(0))
     }
 
+    /// [`Trajectory::read_frame`] asking `cancel` first and before each buffer of input
+    /// (about 1 MiB): once it returns true the read stops with [`ReadError::Cancelled`] (a
+    /// viewer stops reading a time step the user has moved past). The next read of any frame
+    /// starts afresh from that frame's start.
+    pub fn read_frame_unless(
+        &mut self,
+        k: usize,
+        cancel: CancelTest,
+    ) -> Result<Molecule, ReadError> {
+        if cancel() {
+            return Err(ReadError::Cancelled {
+                path: self.path.to_path_buf(),
+            });
+        }
+        self.cancel = Some(cancel);
+        let r = self.read_frame(k);
+        self.cancel = None;
+        self.reader.cancel = None;
+        r
+    }
+
     /// Read frame `k` (0-based). Sequential calls (`k` = the next frame) do not re-read.
     pub fn read_frame(&mut self, k: usize) -> Result<Molecule, ReadError> {
         if k != self.next_index || self.failed {
@@ -675,6 +706,7 @@ impl Trajectory {
             return Ok(None);
         }
         self.reader.frame = self.next_index;
+        self.reader.cancel = self.cancel.clone();
         match self.parser.next_frame(&mut self.reader) {
             Ok(Some(m)) => {
                 self.next_index += 1;

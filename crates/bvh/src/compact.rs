@@ -20,7 +20,7 @@ mod qnode;
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd, V3};
 
-use crate::geometry::{Aabb, Geometry, Prim};
+use crate::geometry::{trimmed_stick, Aabb, Geometry, Prim};
 use crate::intersect::{intersect_ball, intersect_bond};
 use crate::traverse::{load_packet, PacketHit, Ray, RayPacket, BOX_GROW};
 use crate::tree::Bvh;
@@ -372,6 +372,27 @@ impl CompactBvh {
         hit
     }
 
+    /// Endpoints (Å) of stick `j` as drawn: trimmed at both ends as the geometry's records
+    /// are when balls are drawn (the part inside both end balls is never seen from outside
+    /// them).
+    pub fn stick_ends(&self, j: usize) -> ([f32; 3], [f32; 3]) {
+        let [a, b] = self.bonds[j];
+        self.drawn_stick(self.points[a as usize], self.points[b as usize])
+    }
+
+    /// [`CompactBvh::stick_ends`] of the stick between points `p` and `q`.
+    #[inline(always)]
+    fn drawn_stick(&self, p: [f32; 4], q: [f32; 4]) -> ([f32; 3], [f32; 3]) {
+        let (p3, q3) = ([p[0], p[1], p[2]], [q[0], q[1], q[2]]);
+        let trim = self.n_balls > 0 && !self.capped;
+        if !trim {
+            return (p3, q3);
+        }
+        let (start, axis, len) = trimmed_stick(p3, q3, [p[3], q[3]], self.stick_radius, trim);
+        let end = std::array::from_fn(|k| (start[k] as f64 + axis[k] * len) as f32);
+        (start, end)
+    }
+
     /// The leaf test of slot `slot`'s primitive for lanes `m`.
     #[inline(always)]
     fn intersect_prim<S: Simd>(
@@ -389,7 +410,7 @@ impl CompactBvh {
         } else {
             let [a, b] = self.bonds[(id - self.n_balls) as usize];
             let (p, q) = (self.points[a as usize], self.points[b as usize]);
-            let (p, q) = ([p[0], p[1], p[2]], [q[0], q[1], q[2]]);
+            let (p, q) = self.drawn_stick(p, q);
             intersect_bond(
                 s,
                 ray,

@@ -4,6 +4,12 @@
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
+use crate::intersect::end_point;
+
+mod stick;
+
+pub(crate) use stick::trimmed_stick;
+
 /// Atoms drawn as balls, structure of arrays. Positions and radii in Ångström (Å).
 ///
 /// The balls also give the stick endpoints, so they are needed even when balls are not drawn
@@ -97,8 +103,10 @@ pub enum Prim {
 /// Per-primitive data read by the intersection kernels: 8 floats, 32 bytes.
 ///
 /// Sphere: centre `p0`, radius `r`, `axis = 0`, `len = -1` (the marker for a sphere).
-/// Stick: base point `p0` (centre of atom a), radius `r`, unit `axis` towards atom b,
-/// `len` = distance between the atoms (Å, may be 0 for a degenerate stick).
+/// Stick: base point `p0`, radius `r`, unit `axis` towards endpoint b, length `len` (Å, may be
+/// 0 for a degenerate or wholly hidden stick): the bond from endpoint a to b, trimmed at both
+/// ends by the same length where balls are drawn (the part inside both balls; see
+/// [`Geometry::record`]), so its midpoint is the bond's.
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(32))]
 pub struct PrimRecord {
@@ -317,7 +325,11 @@ impl Geometry {
         }
     }
 
-    /// The kernel record of primitive `id`.
+    /// The kernel record of primitive `id`. With balls drawn and open sticks, a stick is
+    /// trimmed at both ends by the same length, 0.999 × the shorter of `√(R² − r²)` over its
+    /// two balls (R: ball radius, r: stick radius): what is cut lies inside both balls, so no
+    /// ray from outside them sees a difference, and the BVH's stick boxes are smaller
+    /// (ns740k: SAH cost 349 → 290).
     pub fn record(&self, id: u32) -> PrimRecord {
         match self.prim(id) {
             Prim::Ball(i) => {
@@ -330,30 +342,7 @@ impl Geometry {
                 }
             }
             Prim::Stick(j) => {
-                let j = j as usize;
-                let p0 = self.endpoint(self.sticks.a[j]);
-                let p1 = self.endpoint(self.sticks.b[j]);
-                // Axis in f64 so the unit vector is as exact as f32 allows.
-                let d = [
-                    p1[0] as f64 - p0[0] as f64,
-                    p1[1] as f64 - p0[1] as f64,
-                    p1[2] as f64 - p0[2] as f64,
-                ];
-                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                let (axis, len) = if len > 0.0 && len.is_finite() {
-                    (
-                        [
-                            (d[0] / len) as f32,
-                            (d[1] / len) as f32,
-                            (d[2] / len) as f32,
-                        ],
-                        len as f32,
-                    )
-                } else if len == 0.0 {
-                    ([0.0; 3], 0.0)
-                } else {
-                    ([f32::NAN; 3], f32::NAN)
-                };
+                let (p0, axis, len) = self.stick_segment(j as usize);
                 PrimRecord {
                     p0,
                     r: self.sticks.radius,
@@ -372,23 +361,34 @@ impl Geometry {
                 let c = self.balls.center(i as usize);
                 (c, c, self.balls.radius[i as usize])
             }
-            Prim::Stick(j) => (
-                self.endpoint(self.sticks.a[j as usize]),
-                self.endpoint(self.sticks.b[j as usize]),
-                self.sticks.radius,
-            ),
+            Prim::Stick(j) => {
+                let (p0, axis, len) = self.stick_segment(j as usize);
+                if len <= 0.0 && self.trims_sticks() {
+                    // Wholly inside its two balls: never the first thing a ray meets.
+                    return Aabb::EMPTY;
+                }
+                let p1 = end_point(&PrimRecord {
+                    p0,
+                    r: 0.0,
+                    axis,
+                    len,
+                });
+                (p0, p1, self.sticks.radius)
+            }
         };
         let finite = p0.iter().chain(p1.iter()).all(|v| v.is_finite()) && r.is_finite();
         if !finite || r < 0.0 {
             return Aabb::EMPTY;
         }
-        // Cylinders (open or capped) and spheres both fit in the box of the two endpoint
-        // spheres. Pad by a few ulps so rounding in the kernels never pokes outside.
+        // Spheres and capsules fit in the box of the two endpoint spheres; an open cylinder
+        // reaches only r·√(1 − a_k²) beyond its axis along axis k (a: its unit axis). Pad by
+        // a few ulps so rounding in the kernels never pokes outside.
+        let reach = self.stick_reach(id, p0, p1, r);
         let mut b = Aabb::EMPTY;
         for k in 0..3 {
-            let lo = p0[k].min(p1[k]) - r;
-            let hi = p0[k].max(p1[k]) + r;
-            let pad = (lo.abs().max(hi.abs())) * 4.0 * f32::EPSILON;
+            let lo = p0[k].min(p1[k]) - reach[k];
+            let hi = p0[k].max(p1[k]) + reach[k];
+            let pad = (lo.abs().max(hi.abs()) + r) * 4.0 * f32::EPSILON;
             b.min[k] = lo - pad;
             b.max[k] = hi + pad;
         }

@@ -22,9 +22,7 @@ fn brute(c: &CompactBvh, ray: &Ray) -> Option<(f32, Prim)> {
             let q = c.points[id as usize];
             intersect_ball(s, &p, p.active, [q[0], q[1], q[2]], q[3], id as i32, &mut h);
         } else {
-            let [a, b] = c.bonds[(id - c.n_balls) as usize];
-            let (x, y) = (c.points[a as usize], c.points[b as usize]);
-            let (x, y) = ([x[0], x[1], x[2]], [y[0], y[1], y[2]]);
+            let (x, y) = c.stick_ends((id - c.n_balls) as usize);
             intersect_bond(
                 s,
                 &p,

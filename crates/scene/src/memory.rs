@@ -15,15 +15,18 @@ mod peak;
 
 pub use peak::{retained_bytes, Peak, PeakPhase, BASELINE_BYTES};
 
-/// Binary BVH nodes per primitive (binned SAH builder, leaves of ≤ 4): measured 0.696 on
-/// nanobowl and 0.654 on ns90k.
+/// Binary BVH nodes per primitive (binned SAH builder, leaves of ≤ 4), sticks trimmed to the
+/// part outside their balls: measured 0.658 (nanobowl), 0.652 (ns90k), 0.654 (ns740k), 0.763
+/// (sio2 at 200 K atoms), 0.753 (sio2), 0.664 (anp3), so within ±10 %.
 pub const BVH_NODES_PER_PRIM: f64 = 0.70;
 /// 8-wide BVH nodes per primitive, with `bvh::wide`'s SAH collapse (nodes nearly full:
-/// 6.3-6.7 children on average): measured 0.064 (nanobowl), 0.059 (ns90k), 0.057 (ns740k),
-/// 0.068 (sio2 at 200 K atoms), 0.063 (sio2), 0.060 (anp3), so within ±10 %. (The greedy
-/// collapse before it: 0.097, 0.122, 0.124, 0.085, 0.148, its half-empty bottom nodes
-/// depending on the depth of the binary tree.)
-pub const WIDE_NODES_PER_PRIM: f64 = 0.062;
+/// 6.3-6.7 children on average), sticks trimmed: measured 0.060 (nanobowl), 0.058 (ns90k),
+/// 0.056 (ns740k), 0.072 (sio2 at 200 K atoms), 0.067 (sio2), 0.057 (anp3), so within ±13 %
+/// (±10 % with whole sticks, whose larger boxes gave the SAH fewer splits at sio2's bottom
+/// levels: 0.064, 0.059, 0.057, 0.068, 0.063, 0.060). (The greedy collapse before it: 0.097,
+/// 0.122, 0.124, 0.085, 0.148, its half-empty bottom nodes depending on the depth of the
+/// binary tree.)
+pub const WIDE_NODES_PER_PRIM: f64 = 0.0635;
 /// Bytes per pixel of the frame `render` draws: the packed RGBA8 framebuffer (the tile
 /// driver keeps its sums per tile; the f32 `render::Accum` of progressive front ends, 12 B
 /// more per pixel, is not counted). Measured: `render 2r9r-1b.xyz` (1,284 atoms) peaks 12.6 MB

@@ -48,8 +48,8 @@ fn check_estimate(name: SceneName, atoms: Option<usize>, volume: bool) {
     for (a, b) in est.components().iter().zip(real.components()) {
         match a.0 {
             "bvh" => assert!(rel(a.1, b.1) < 0.10, "{name} bvh: {} vs {}", a.1, b.1),
-            // One constant for the wide node count: 0.057-0.068 nodes per primitive measured.
-            "wide_bvh" => assert!(rel(a.1, b.1) < 0.10, "{name} wide: {} vs {}", a.1, b.1),
+            // One constant for the wide node count: 0.056-0.072 nodes per primitive measured.
+            "wide_bvh" => assert!(rel(a.1, b.1) < 0.13, "{name} wide: {} vs {}", a.1, b.1),
             _ => assert_eq!(a.1, b.1, "{name} {}", a.0),
         }
     }

@@ -362,15 +362,31 @@ impl ClassifiedTf {
             .into_par_iter()
             .map(|d| sub_step_opacities(&fine, sub_steps(d), step_voxels))
             .collect();
+        // LANES rows at a time: for each signed bin distance Δ the rows' pairs (f, f + Δ) share
+        // n and `alphas[|Δ|]`, so their latency-bound chains interleave (lanes whose f + Δ is
+        // off the table compute a valid pair and are dropped).
         let mut preint = vec![0.0f32; TF_SIZE * TF_SIZE * 4];
         preint
-            .par_chunks_mut(TF_SIZE * 4)
+            .par_chunks_mut(LANES * TF_SIZE * 4)
             .enumerate()
-            .for_each(|(f, row)| {
-                for b in 0..TF_SIZE {
-                    let alpha = &alphas[f.abs_diff(b)];
-                    let v = preintegrate_fine(&fine, alpha, f as f32, b as f32);
-                    row[b * 4..b * 4 + 4].copy_from_slice(&v);
+            .for_each(|(chunk, rows)| {
+                let (f0, last) = ((chunk * LANES) as isize, TF_SIZE as isize - 1);
+                for delta in -last..=last {
+                    // The rows f whose back bin f + Δ is on the table.
+                    let (lo, hi) = ((-delta).max(0), last.min(last - delta));
+                    if f0 > hi || f0 + (LANES as isize) <= lo {
+                        continue;
+                    }
+                    let f = core::array::from_fn(|l| (f0 + l as isize).clamp(lo, hi) as f32);
+                    let v =
+                        preintegrate_lanes(&fine, &alphas[delta.unsigned_abs()], f, delta as f32);
+                    for (l, v) in v.iter().enumerate() {
+                        let f = f0 + l as isize;
+                        if (lo..=hi).contains(&f) {
+                            let at = (l * TF_SIZE + (f + delta) as usize) * 4;
+                            rows[at..at + 4].copy_from_slice(v);
+                        }
+                    }
                 }
             });
         let preint_half = preint
@@ -440,23 +456,40 @@ fn sub_step_opacities(fine: &[[f32; 4]], n: usize, len: f32) -> Vec<f32> {
     fine.iter().map(|e| 1.0 - (-dl * e[3]).exp()).collect()
 }
 
-/// [`preintegrate`] between whole bins `f` and `b`, with the classification looked up in
-/// `fine` (`[r, g, b, τ]` every 1/16 bin, nearest) and each sub-step's opacity in `alpha`
-/// ([`sub_step_opacities`] for `|b − f|`), in f32.
-fn preintegrate_fine(fine: &[[f32; 4]], alpha: &[f32], f: f32, b: f32) -> [f32; 4] {
-    let n = sub_steps((b - f).abs() as usize);
-    let (mut c, mut t) = ([0.0f32; 3], 1.0f32);
+/// Pre-integrated rows processed together (independent chains per loop iteration).
+const LANES: usize = 16;
+const _: () = assert!(TF_SIZE.is_multiple_of(LANES));
+
+/// [`preintegrate`] from whole bin `f[l]` to `f[l] + delta` for each lane `l`, with the
+/// classification looked up in `fine` (`[r, g, b, τ]` every 1/16 bin, nearest) and each
+/// sub-step's opacity in `alpha` ([`sub_step_opacities`] for `|delta|`), in f32; each lane does
+/// the f32 operations of the single-pair loop in its order, so the result is bit for bit that.
+fn preintegrate_lanes(
+    fine: &[[f32; 4]],
+    alpha: &[f32],
+    f: [f32; LANES],
+    delta: f32,
+) -> [[f32; 4]; LANES] {
+    let n = sub_steps(delta.abs() as usize);
+    assert_eq!(alpha.len(), fine.len());
+    let (mut c, mut t) = ([[0.0f32; 4]; LANES], [1.0f32; LANES]);
     for k in 0..n {
-        let x = f + (b - f) * (k as f32 + 0.5) / n as f32;
-        let i = (x * FINE as f32 + 0.5) as usize;
-        let (e, a) = (fine[i], alpha[i]);
-        let w = t * a;
-        for ch in 0..3 {
-            c[ch] += w * e[ch];
+        // `(b − f)·(k + ½)/n`, the same for every lane (b − f = delta exactly).
+        let dx = delta * (k as f32 + 0.5) / n as f32;
+        // Each lane's fine sample: `as i32` truncates as `as usize` would (0 < x < 4081) with
+        // fewer instructions.
+        let i: [i32; LANES] = core::array::from_fn(|l| ((f[l] + dx) * FINE as f32 + 0.5) as i32);
+        for l in 0..LANES {
+            let (e, a) = (fine[i[l] as usize], alpha[i[l] as usize]);
+            let w = t[l] * a;
+            // Four channels so that the loop is one vector operation; the fourth (w·τ) is unused.
+            for ch in 0..4 {
+                c[l][ch] += w * e[ch];
+            }
+            t[l] *= 1.0 - a;
         }
-        t *= 1.0 - a;
     }
-    [c[0], c[1], c[2], 1.0 - t]
+    core::array::from_fn(|l| [c[l][0], c[l][1], c[l][2], 1.0 - t[l]])
 }
 
 /// Premultiplied RGBA of a segment of `len` voxels whose bin coordinate goes linearly from

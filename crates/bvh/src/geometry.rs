@@ -4,8 +4,6 @@
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
-use crate::intersect::end_point;
-
 mod stick;
 
 pub(crate) use stick::trimmed_stick;
@@ -356,34 +354,23 @@ impl Geometry {
     /// Bounds of primitive `id`. Primitives with a non-finite coordinate or radius get an empty
     /// box (they can never be hit).
     pub fn prim_bounds(&self, id: u32) -> Aabb {
-        let (p0, p1, r) = match self.prim(id) {
+        let (p0, p1, reach) = match self.prim(id) {
             Prim::Ball(i) => {
-                let c = self.balls.center(i as usize);
-                (c, c, self.balls.radius[i as usize])
+                let (c, r) = (self.balls.center(i as usize), self.balls.radius[i as usize]);
+                (c, c, [r; 3])
             }
-            Prim::Stick(j) => {
-                let (p0, axis, len) = self.stick_segment(j as usize);
-                if len <= 0.0 && self.trims_sticks() {
-                    // Wholly inside its two balls: never the first thing a ray meets.
-                    return Aabb::EMPTY;
-                }
-                let p1 = end_point(&PrimRecord {
-                    p0,
-                    r: 0.0,
-                    axis,
-                    len,
-                });
-                (p0, p1, self.sticks.radius)
-            }
+            Prim::Stick(j) => match self.stick_extent(j as usize) {
+                Some(e) => e,
+                None => return Aabb::EMPTY,
+            },
         };
+        let r = reach[0].max(reach[1]).max(reach[2]);
         let finite = p0.iter().chain(p1.iter()).all(|v| v.is_finite()) && r.is_finite();
         if !finite || r < 0.0 {
             return Aabb::EMPTY;
         }
-        // Spheres and capsules fit in the box of the two endpoint spheres; an open cylinder
-        // reaches only r·√(1 − a_k²) beyond its axis along axis k (a: its unit axis). Pad by
-        // a few ulps so rounding in the kernels never pokes outside.
-        let reach = self.stick_reach(id, p0, p1, r);
+        // The segment's box grown by the reach per axis; padded by a few ulps so rounding in
+        // the kernels never pokes outside.
         let mut b = Aabb::EMPTY;
         for k in 0..3 {
             let lo = p0[k].min(p1[k]) - reach[k];

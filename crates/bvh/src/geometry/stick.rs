@@ -4,7 +4,7 @@
 //! keeps the colour change at the bond's midpoint and tightens the BVH's boxes (ns740k: SAH
 //! 349 → 290).
 
-use super::{Geometry, Prim};
+use super::Geometry;
 
 /// Fraction of the hidden length trimmed: the last 0.1 % stays, so rounding never opens a gap
 /// between a ball and its stick where the stick leaves the ball.
@@ -34,18 +34,39 @@ impl Geometry {
         (start, axis.map(|v| v as f32), len as f32)
     }
 
-    /// How far primitive `id` reaches beyond the segment `p0`–`p1` along x, y and z (Å): `r`
-    /// for balls and capsules, `r·√(1 − a_k²)` for an open cylinder of unit axis `a`.
-    pub(super) fn stick_reach(&self, id: u32, p0: [f32; 3], p1: [f32; 3], r: f32) -> [f32; 3] {
-        if self.capped || matches!(self.prim(id), Prim::Ball(_)) {
-            return [r; 3];
-        }
-        let d: [f64; 3] = std::array::from_fn(|k| p1[k] as f64 - p0[k] as f64);
+    /// Segment (Å) a box around stick `j` must cover, and how far the stick reaches beyond it
+    /// along x, y and z (Å): `r` for a capsule, `r·√(1 − a_k²)` for an open cylinder of unit
+    /// axis `a`. In f32 for the builder's speed, the trim 10⁻⁴ shorter than the record's so the
+    /// rounding of either stays inside the box. `None`: hidden whole (no box).
+    pub(super) fn stick_extent(&self, j: usize) -> Option<([f32; 3], [f32; 3], [f32; 3])> {
+        let (ia, ib) = (self.sticks.a[j], self.sticks.b[j]);
+        let (p, q, rs) = (self.endpoint(ia), self.endpoint(ib), self.sticks.radius);
+        let d: [f32; 3] = std::array::from_fn(|k| q[k] - p[k]);
         let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if !(len2 > 0.0 && len2.is_finite()) {
-            return [r; 3];
+            // Degenerate (or non-finite, which the caller rejects): the endpoints' spheres.
+            let hidden = self.trims_sticks() && len2 == 0.0;
+            return (!hidden).then_some((p, q, [rs; 3]));
         }
-        d.map(|v| (r as f64 * (1.0 - v * v / len2).max(0.0).sqrt()) as f32)
+        let reach = if self.capped {
+            [rs; 3]
+        } else {
+            d.map(|v| rs * (1.0 - v * v / len2).max(0.0).sqrt())
+        };
+        let ball = |i: u32| self.balls.radius.get(i as usize).copied().unwrap_or(0.0);
+        let rmin = ball(ia).min(ball(ib));
+        if !self.trims_sticks() || rmin <= rs {
+            return Some((p, q, reach));
+        }
+        let len = len2.sqrt();
+        let cut = (TRIM * (1.0 - 1e-4)) as f32 * (rmin * rmin - rs * rs).sqrt();
+        if 2.0 * cut >= len {
+            return None;
+        }
+        let f = cut / len;
+        let start = std::array::from_fn(|k| p[k] + d[k] * f);
+        let end = std::array::from_fn(|k| q[k] - d[k] * f);
+        Some((start, end, reach))
     }
 }
 
@@ -55,6 +76,7 @@ impl Geometry {
 /// `ball` (0 for a ball no wider than the stick or an extra end, radius 0): where the cylinder's
 /// surface meets a ball, so what is cut lies inside both balls. Zero length and axis for
 /// coincident endpoints; NaN axis and length for non-finite ones.
+#[inline]
 pub(crate) fn trimmed_stick(
     p: [f32; 3],
     q: [f32; 3],
@@ -71,16 +93,14 @@ pub(crate) fn trimmed_stick(
         return (p, [f64::NAN; 3], f64::NAN);
     }
     let axis = d.map(|v| v / len);
-    let rs = rs as f64;
-    let hidden = |r: f32| {
-        let r = r as f64;
-        if trim && r > rs {
-            (r * r - rs * rs).sqrt()
-        } else {
-            0.0
-        }
+    // The smaller ball hides less: √(R² − rs²) grows with R.
+    let (rs, rmin) = (rs as f64, ball[0].min(ball[1]) as f64);
+    let hidden = if trim && rmin > rs {
+        (rmin * rmin - rs * rs).sqrt()
+    } else {
+        0.0
     };
-    let cut = (TRIM * hidden(ball[0]).min(hidden(ball[1]))).min(len / 2.0);
+    let cut = (TRIM * hidden).min(len / 2.0);
     let start = std::array::from_fn(|k| (p[k] as f64 + axis[k] * cut) as f32);
     (start, axis, len - 2.0 * cut)
 }

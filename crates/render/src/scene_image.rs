@@ -49,7 +49,7 @@ impl SceneFrame<'_> {
     pub fn with_inputs<R>(&self, f: impl FnOnce(&FrameInputs) -> R) -> R {
         let vscene = self.scene.volume_scene(self.settings.march);
         f(&FrameInputs {
-            model: self.scene.model.as_ref(),
+            model: self.scene.model.as_deref(),
             volume: vscene.as_ref(),
             camera: self.camera,
         })

@@ -204,7 +204,7 @@ fn for_every_case(
         for (name, set, vol) in settings() {
             let vs = sc.volume_scene(set.march).filter(|_| vol);
             let inp = FrameInputs {
-                model: sc.model.as_ref(),
+                model: sc.model.as_deref(),
                 volume: vs.as_ref(),
                 camera: cam,
             };

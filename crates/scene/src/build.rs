@@ -3,6 +3,7 @@
 //! light volume (paper §4.1 steps 3-5), with per-stage timings and a memory check first.
 
 use std::sync::atomic::Ordering;
+use std::sync::Arc;
 use std::time::Instant;
 
 use molecule::bonds::{try_build_bonds_with_progress, BondError, BondOptions};
@@ -101,7 +102,7 @@ pub struct Scene {
     /// Bonds (pairs of atom indices; empty without a model).
     pub bonds: Vec<[u32; 2]>,
     /// Ball-and-stick model (geometry + BVH).
-    pub model: Option<Model>,
+    pub model: Option<Arc<Model>>,
     /// Density volume.
     pub volume: Option<DensityVolume>,
     /// Light volume of volumetric shadows.
@@ -118,6 +119,16 @@ pub struct Scene {
     scratch: (Vec<f32>, Vec<u32>),
 }
 
+/// A model already built for a frame, with the settings of the scene it was built for, that
+/// [`Scene::build_sharing`] may take instead of building its own.
+#[derive(Clone)]
+pub struct SharedModel {
+    /// The model.
+    pub model: Arc<Model>,
+    /// The settings it was built with (their `model` and `bonds` must match to share it).
+    pub settings: SceneSettings,
+}
+
 impl Scene {
     /// Builds the scene of `m` with backend `isa` (density and light volume kernels).
     pub fn build(isa: Isa, m: &Molecule, settings: &SceneSettings) -> Result<Scene, SceneError> {
@@ -130,6 +141,20 @@ impl Scene {
         m: &Molecule,
         settings: &SceneSettings,
         progress: &Progress,
+    ) -> Result<Scene, SceneError> {
+        Scene::build_sharing(isa, m, settings, progress, None)
+    }
+
+    /// [`Scene::build_with`] sharing `shared`'s model, built for the same frame `m`, when
+    /// `settings` asks for the same model and bonds: no BVH is built and the model is not held
+    /// twice (the viewer's first time step, built again with its volume behind the model on
+    /// screen). Otherwise the model is built as usual.
+    pub fn build_sharing(
+        isa: Isa,
+        m: &Molecule,
+        settings: &SceneSettings,
+        progress: &Progress,
+        shared: Option<&SharedModel>,
     ) -> Result<Scene, SceneError> {
         let mut s = Scene {
             settings: settings.clone(),
@@ -146,7 +171,12 @@ impl Scene {
             unwrap: None,
             scratch: (Vec::new(), Vec::new()),
         };
-        s.rebuild_with(isa, m, progress)?;
+        let shared = shared.filter(|sh| {
+            settings.model.is_some()
+                && sh.settings.model == settings.model
+                && sh.settings.bonds == settings.bonds
+        });
+        s.build_frame(isa, m, progress, shared.map(|sh| &sh.model))?;
         Ok(s)
     }
 
@@ -163,6 +193,18 @@ impl Scene {
         isa: Isa,
         m: &Molecule,
         progress: &Progress,
+    ) -> Result<(), SceneError> {
+        self.build_frame(isa, m, progress, None)
+    }
+
+    /// Builds every part the settings ask for over frame `m`, taking the model from `shared`
+    /// (built for `m` with the same model and bond settings) instead of building it.
+    fn build_frame(
+        &mut self,
+        isa: Isa,
+        m: &Molecule,
+        progress: &Progress,
+        shared: Option<&Arc<Model>>,
     ) -> Result<(), SceneError> {
         if m.is_empty() {
             return Err(SceneError::NoAtoms);
@@ -203,9 +245,11 @@ impl Scene {
         // the frame and the bonds), since the budget is a share of the memory still available.
         self.estimate = MemoryEstimate::new(m, self.bonds.len(), st)?;
         let e = &self.estimate;
+        // A shared model is resident already and not built again.
+        let model_bytes = shared.map_or(0, |_| e.geometry + e.bvh + e.wide_bvh);
         let needed = e
             .peak_bytes()
-            .saturating_sub(e.peak.baseline + e.atoms + self.bonds.len() as u64 * 8);
+            .saturating_sub(e.peak.baseline + e.atoms + self.bonds.len() as u64 * 8 + model_bytes);
         if let Some(budget) = st.budget_bytes.or_else(volume::default_budget_bytes) {
             if needed > budget {
                 return Err(SceneError::TooLarge {
@@ -215,7 +259,12 @@ impl Scene {
                 });
             }
         }
-        if let Some(ms) = &st.model {
+        if let (Some(ms), Some(model)) = (&st.model, shared) {
+            if ms.wide_bvh {
+                model.wide();
+            }
+            self.model = Some(model.clone());
+        } else if let Some(ms) = &st.model {
             let prims = model_prim_count(m.len(), self.bonds.len(), ms).1;
             progress.start(Stage::Model, prims as u64)?;
             let t = Instant::now();
@@ -223,7 +272,7 @@ impl Scene {
             if ms.wide_bvh {
                 model.wide();
             }
-            self.model = Some(model);
+            self.model = Some(Arc::new(model));
             self.timings.model = t.elapsed().as_secs_f64();
         }
         if let Some(vs) = &st.volume {
@@ -320,7 +369,7 @@ impl Scene {
         if (progress.cancelled)() {
             return Err(SceneError::Cancelled);
         }
-        self.sphere = bounding_sphere(m, self.model.as_ref());
+        self.sphere = bounding_sphere(m, self.model.as_deref());
         Ok(())
     }
 

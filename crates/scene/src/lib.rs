@@ -24,7 +24,7 @@ mod report;
 mod settings;
 pub mod text;
 
-pub use build::{Density, DensityVolume, Prepared, Scene, UnwrapReport};
+pub use build::{Density, DensityVolume, Prepared, Scene, SharedModel, UnwrapReport};
 pub use camera::{Camera, Projection, View};
 pub use camera_spec::CameraSpecError;
 pub use colormap::{viridis, Colormap};

@@ -3,7 +3,7 @@
 
 use molecule::scenes::{generate, SceneName};
 use scene::{
-    BondSettings, BondSource, ColorBy, MemoryEstimate, ModelSettings, Scene, SceneError,
+    BondSettings, BondSource, ColorBy, MemoryEstimate, ModelSettings, Progress, Scene, SceneError,
     SceneSettings, Style,
 };
 use spmd::Isa;
@@ -225,4 +225,48 @@ fn ball_sphere_is_the_models_sphere_without_building_it() {
             model.radius
         );
     }
+}
+
+/// A scene built with the volume over the same frame's model shares that model (the same
+/// `Arc`, no second BVH) and draws what a scene built alone has (the same BVH node for node);
+/// other model settings build their own. Its budget check leaves the shared model out: a budget
+/// below the whole scene's peak but above the part still to build passes.
+#[test]
+fn a_scene_shares_the_model_built_for_its_frame() {
+    let m = generate(SceneName::Ns90k, Some(20_000), 1);
+    let first = Scene::build(Isa::Scalar, &m, &settings(false, false)).unwrap();
+    let shared = scene::SharedModel {
+        model: first.model.clone().unwrap(),
+        settings: first.settings.clone(),
+    };
+    let full = settings(false, true);
+    let alone = Scene::build(Isa::Scalar, &m, &full).unwrap();
+    let p = Progress::none();
+    let s = Scene::build_sharing(Isa::Scalar, &m, &full, &p, Some(&shared)).unwrap();
+    let (model, own) = (s.model.as_ref().unwrap(), alone.model.as_ref().unwrap());
+    assert!(std::sync::Arc::ptr_eq(model, &shared.model));
+    assert!(model.bvh.nodes == own.bvh.nodes && model.bvh.records == own.bvh.records);
+    assert_eq!(s.bonds, alone.bonds);
+    assert!(s.volume.is_some() && s.sphere.center == alone.sphere.center);
+    // Different balls: a model of its own.
+    let mut bigger = full.clone();
+    bigger.model.as_mut().unwrap().radius_scale = 0.6;
+    let s2 = Scene::build_sharing(Isa::Scalar, &m, &bigger, &p, Some(&shared)).unwrap();
+    assert!(!std::sync::Arc::ptr_eq(
+        s2.model.as_ref().unwrap(),
+        &shared.model
+    ));
+    // The budget: between the volume's share and the whole scene's.
+    let e = &alone.estimate;
+    let whole = e.peak_bytes() - (e.peak.baseline + e.atoms + e.bonds);
+    let budget = whole - (e.geometry + e.bvh) / 2;
+    let tight = SceneSettings {
+        budget_bytes: Some(budget),
+        ..full
+    };
+    assert!(matches!(
+        Scene::build(Isa::Scalar, &m, &tight),
+        Err(SceneError::TooLarge { .. })
+    ));
+    assert!(Scene::build_sharing(Isa::Scalar, &m, &tight, &p, Some(&shared)).is_ok());
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use render::{FrameInputs, Framebuffer, RenderSettings};
-use scene::{Camera, Scene, SceneSettings, Sphere};
+use scene::{Camera, Scene, SceneSettings, SharedModel, Sphere};
 use spmd::Isa;
 
 use crate::error::ViewError;
@@ -226,6 +226,7 @@ impl App {
             id: self.next_id,
             frame,
             settings,
+            shared: None,
         });
     }
 
@@ -597,10 +598,16 @@ impl App {
                 fix_ranges(&mut sup, r);
             }
             self.next_id += 1;
+            // The model on screen is this step's: shared, not built (and held) twice.
+            let shared = self.shown.as_ref().and_then(|sh| {
+                let (model, settings) = (sh.scene.model.clone()?, sh.scene.settings.clone());
+                Some(SharedModel { model, settings })
+            });
             self.loader.request(Request {
                 id: self.next_id,
                 frame,
                 settings: (*sup).clone(),
+                shared,
             });
             self.upgrade = Upgrade::Asked(self.next_id, frame, sup);
         }
@@ -786,7 +793,7 @@ fn with_inputs<R>(
         None
     };
     f(&FrameInputs {
-        model: shown.scene.model.as_ref().filter(|_| m != Mode::Volume),
+        model: shown.scene.model.as_deref().filter(|_| m != Mode::Volume),
         volume: volume.as_ref(),
         camera,
     })

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use molecule::read::{CancelTest, FrameIndex, ReadError, Trajectory};
 use molecule::Molecule;
-use scene::{Progress, Scene, SceneError, SceneSettings};
+use scene::{Progress, Scene, SceneError, SceneSettings, SharedModel};
 use spmd::Isa;
 
 /// Where the time steps come from.
@@ -77,6 +77,9 @@ pub struct Request {
     pub frame: usize,
     /// What the scene holds.
     pub settings: SceneSettings,
+    /// A model already built for this time step that the scene may share instead of
+    /// building its own ([`Scene::build_sharing`]).
+    pub shared: Option<SharedModel>,
 }
 
 /// What the loader sends back.
@@ -267,7 +270,7 @@ fn serve(
                         cancelled: &stale,
                         ..Progress::none()
                     };
-                    Scene::build_with(isa, &m, &r.settings, &progress)
+                    Scene::build_sharing(isa, &m, &r.settings, &progress, r.shared.as_ref())
                 };
                 match pool.as_ref().map_or_else(|_| build(), |p| p.install(build)) {
                     Err(SceneError::Cancelled) => cancelled(),
@@ -351,12 +354,14 @@ mod tests {
             id: 1,
             frame: 0,
             settings: full,
+            shared: None,
         });
         std::thread::sleep(Duration::from_millis(50));
         l.request(Request {
             id: 2,
             frame: 0,
             settings: model,
+            shared: None,
         });
         let start = Instant::now();
         let mut first = Vec::new();
@@ -373,5 +378,50 @@ mod tests {
         assert_eq!(first, [1]);
         assert!(second.volume.is_none() && second.model.is_some());
         assert!(!l.busy());
+    }
+
+    /// The first time step's upgrade shares the model on screen: the scene sent back holds the
+    /// same model (no second BVH), and its volume.
+    #[test]
+    fn a_request_with_the_model_on_screen_shares_it() {
+        let m = generate(SceneName::Nanobowl, Some(3000), 1);
+        let source = FrameSource::One(Box::new(m), "nanobowl".into());
+        let mut l = Loader::start(source, Isa::Scalar, 2);
+        let model = SceneSettings {
+            model: Some(ModelSettings::default()),
+            budget_bytes: Some(u64::MAX),
+            ..SceneSettings::default()
+        };
+        let full = SceneSettings {
+            volume: Some(VolumeSettings::default()),
+            ..model.clone()
+        };
+        let wait = |l: &mut Loader, want: u64| loop {
+            match l.poll() {
+                Some(Answer::Built { id, scene, .. }) if id == want => break scene.unwrap(),
+                Some(Answer::Built { id, .. }) => panic!("request {id} answered"),
+                _ => std::thread::sleep(Duration::from_millis(5)),
+            }
+        };
+        l.request(Request {
+            id: 1,
+            frame: 0,
+            settings: model,
+            shared: None,
+        });
+        let first = wait(&mut l, 1);
+        let shared = SharedModel {
+            model: first.model.clone().unwrap(),
+            settings: first.settings.clone(),
+        };
+        l.request(Request {
+            id: 2,
+            frame: 0,
+            settings: full,
+            shared: Some(shared.clone()),
+        });
+        let up = wait(&mut l, 2);
+        assert!(Arc::ptr_eq(up.model.as_ref().unwrap(), &shared.model));
+        assert!(up.volume.is_some());
     }
 }

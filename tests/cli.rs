@@ -270,6 +270,41 @@ fn memory_budget_refuses_with_the_way_out_and_allows_what_fits() {
     assert!(out.exists());
 }
 
+/// Hostile resolutions of the density grid: too coarse to hold any density, or too fine for
+/// 2³¹ lattice points (up to past `usize`, which once wrapped to a tiny grid), are refused
+/// with the way out and no panic; `info` refuses them too instead of printing a wrapped size.
+#[test]
+fn density_resolutions_that_cannot_work_are_refused_with_the_way_out() {
+    let d = scratch("density-resolution");
+    let out = d.join("v.png");
+    for (vpa, says) in [
+        ("0.01", "finer --voxels-per-angstrom"),
+        ("1e30", "2^31-voxel limit"),
+    ] {
+        let (ok, _, err) = run(bnsview()
+            .args([
+                "render", "--scene", "nanobowl", "--atoms", "500", "--size", "40x30",
+            ])
+            .args(["--mode", "volume", "--voxels-per-angstrom", vpa, "-o"])
+            .arg(&out));
+        assert!(
+            !ok && err.contains(says) && !err.contains("panicked"),
+            "{vpa}: {err}"
+        );
+        assert!(!out.exists(), "nothing written when refused");
+    }
+    let (ok, _, err) = run(bnsview().args([
+        "info",
+        "--scene",
+        "nanobowl",
+        "--atoms",
+        "500",
+        "--voxels-per-angstrom",
+        "1e30",
+    ]));
+    assert!(!ok && err.contains("2^31-voxel limit"), "{err}");
+}
+
 /// `--volume particles`: the grid-free volume renders the picture the f32 grid does (same
 /// camera, transfer function range and step; the grid's interpolation is the difference),
 /// says so under -v, and refuses volumetric shadows with the way out.

@@ -338,6 +338,12 @@ impl Scene {
             };
             let t = Instant::now();
             let tf_max = tf_max.unwrap_or(density.max_value());
+            // (A NaN maximum must not reach the classification either.)
+            if tf_max.is_nan() || tf_max <= 0.0 {
+                return Err(SceneError::EmptyDensity {
+                    voxels_per_angstrom: vs.voxels_per_angstrom,
+                });
+            }
             let tf = ClassifiedTf::new(&vs.tf, 0.0, tf_max, vs.step_voxels);
             let empty = DensityVolume::empty_space(&density, &tf);
             self.timings.macrocells += t.elapsed().as_secs_f64();
@@ -708,13 +714,16 @@ fn density_radii(m: &Molecule, out: &mut Vec<f32>) {
 pub(crate) fn density_grid(m: &Molecule, vs: &VolumeSettings) -> Result<Grid, SceneError> {
     let mut r = Vec::new();
     density_radii(m, &mut r);
-    Ok(Grid::for_atoms(
-        &m.x,
-        &m.y,
-        &m.z,
-        &r,
-        vs.voxels_per_angstrom,
-    )?)
+    let grid = Grid::for_atoms(&m.x, &m.y, &m.z, &r, vs.voxels_per_angstrom)?;
+    // Past 2³¹ points no budget matters (and the estimate's sums would overflow): refuse
+    // here, with the resolution that fits.
+    let params = DensityParams {
+        voxels_per_angstrom: vs.voxels_per_angstrom,
+        format: vs.format,
+        budget_bytes: None,
+    };
+    volume::check_size(&grid, [&m.x, &m.y, &m.z, &r], &params, None)?;
+    Ok(grid)
 }
 
 /// The density volume of `m` (`radii` is scratch).

@@ -48,6 +48,18 @@ pub enum SceneError {
     /// No atoms.
     #[error("no atoms to build a scene of")]
     NoAtoms,
+    /// The density grid is zero at every lattice point: its spacing is coarser than the
+    /// atoms' support (each atom's density reaches √2·r from its centre), so the transfer
+    /// function would have no range and the volume nothing to show.
+    #[error(
+        "the density is zero at every lattice point at {voxels_per_angstrom} voxels/Å: \
+        the lattice is coarser than the atoms (each reaches √2 times its radius, a few Å); \
+        use a finer --voxels-per-angstrom (1 to 4 are typical)"
+    )]
+    EmptyDensity {
+        /// The resolution asked for.
+        voxels_per_angstrom: f32,
+    },
     /// The estimate exceeds the memory budget (checked before anything large is allocated).
     #[error("the scene would need about {} MB ({}), over the memory budget of {} MB; \
         fewer atoms, --style spheres (no sticks) or a coarser --voxels-per-angstrom need \

@@ -87,6 +87,48 @@ fn over_budget_is_refused_before_building() {
     }
 }
 
+/// A lattice coarser than the atoms (every lattice point outside every atom's support)
+/// gives a density that is zero everywhere: a typed error naming the way out, not a
+/// transfer function over an empty range (which panicked). A lattice past 2³¹ points is
+/// refused by the volume's size check before the estimate sums its bytes (which overflowed).
+#[test]
+fn a_density_lattice_too_coarse_or_too_fine_is_refused() {
+    let m = generate(SceneName::Nanobowl, Some(2000), 1);
+    let at = |vpa: f32, light: bool| {
+        // The default budget: the estimate is checked against it.
+        let mut st = SceneSettings {
+            budget_bytes: None,
+            ..settings(false, true)
+        };
+        let vs = st.volume.as_mut().unwrap();
+        vs.voxels_per_angstrom = vpa;
+        if !light {
+            vs.light_volume = None;
+        }
+        Scene::build(Isa::Scalar, &m, &st)
+    };
+    for light in [false, true] {
+        match at(0.01, light) {
+            Err(e @ SceneError::EmptyDensity { .. }) => {
+                assert!(e.to_string().contains("--voxels-per-angstrom"), "{e}")
+            }
+            other => panic!(
+                "0.01 voxels/Å: expected EmptyDensity, got {:?}",
+                other.err()
+            ),
+        }
+        for vpa in [1e4, 1e30] {
+            match at(vpa, light) {
+                Err(SceneError::Volume(volume::VolumeError::TooLarge { index_limit, .. })) => {
+                    assert!(index_limit)
+                }
+                other => panic!("{vpa} voxels/Å: expected TooLarge, got {:?}", other.err()),
+            }
+        }
+    }
+    assert!(at(0.5, false).is_ok());
+}
+
 #[test]
 fn bonds_follow_the_source_and_rebuild_reuses_the_settings() {
     let mut m = generate(SceneName::Nanobowl, Some(500), 1);

@@ -13,6 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 use spmd::{Isa, Kernel, Simd};
 
+use crate::grid_size::{check_size, lattice_points};
 use crate::VolumeError;
 pub use bvh::Watch;
 
@@ -99,32 +100,13 @@ impl Grid {
         r: &[f32],
         voxels_per_angstrom: f32,
     ) -> Result<Grid, VolumeError> {
-        check_atoms(x, y, z, r)?;
-        if !(voxels_per_angstrom.is_finite() && voxels_per_angstrom > 0.0) {
-            return Err(VolumeError::BadResolution(voxels_per_angstrom));
-        }
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        let mut rmax = 0.0f32;
-        for i in 0..x.len() {
-            for (a, v) in [x[i], y[i], z[i]].into_iter().enumerate() {
-                lo[a] = lo[a].min(v);
-                hi[a] = hi[a].max(v);
-            }
-            rmax = rmax.max(r[i]);
-        }
-        let h = 1.0 / voxels_per_angstrom;
-        let pad = core::f32::consts::SQRT_2 * rmax + h;
-        let mut dims = [0usize; 3];
-        let mut origin = [0.0f32; 3];
-        for a in 0..3 {
-            origin[a] = lo[a] - pad;
-            let extent = (hi[a] + pad - origin[a]) as f64;
-            dims[a] = ((extent / h as f64).ceil() as usize + 1).max(2);
-        }
+        let (origin, points) = lattice_points(x, y, z, r, voxels_per_angstrom)?;
+        // Saturating: a count past `usize` (atoms 10³⁸ Å apart, or 10³⁰ voxels/Å) stays
+        // enormous, for the size check to refuse, instead of wrapping to a small grid.
+        let dims = points.map(|n| (n as usize).max(2));
         Ok(Grid {
             origin,
-            spacing: h,
+            spacing: 1.0 / voxels_per_angstrom,
             dims,
         })
     }
@@ -242,7 +224,7 @@ impl Volume {
 }
 
 /// Atoms must be four slices of equal length with finite coordinates and positive radii.
-fn check_atoms(x: &[f32], y: &[f32], z: &[f32], r: &[f32]) -> Result<(), VolumeError> {
+pub(crate) fn check_atoms(x: &[f32], y: &[f32], z: &[f32], r: &[f32]) -> Result<(), VolumeError> {
     let n = x.len();
     if y.len() != n || z.len() != n || r.len() != n {
         return Err(VolumeError::LengthMismatch {
@@ -346,32 +328,8 @@ pub fn build_density(
         None => (&unwatched, &|| false),
     };
     let grid = Grid::for_atoms(x, y, z, r, params.voxels_per_angstrom)?;
-    let needed = estimate_bytes(&grid, params.format);
     let budget = params.budget_bytes.or_else(default_budget_bytes);
-    let too_many = grid.voxel_count() > (i32::MAX as u64 - 64);
-    if too_many || budget.is_some_and(|b| needed > b) {
-        let limit = if too_many {
-            (i32::MAX as u64 - 64) * params.format.bytes_per_voxel()
-        } else {
-            budget.unwrap_or(u64::MAX)
-        };
-        let limit = match budget {
-            Some(b) => b.min(limit),
-            None => limit,
-        };
-        // Bytes grow with the cube of the resolution; round the suggestion down to 1/4 voxel/Å.
-        let k = (limit as f64 / needed as f64).cbrt() * 0.97;
-        let suggest = ((params.voxels_per_angstrom as f64 * k) * 4.0).floor() / 4.0;
-        return Err(VolumeError::TooLarge {
-            needed,
-            limit,
-            dims: grid.dims,
-            voxels_per_angstrom: params.voxels_per_angstrom,
-            format: params.format,
-            suggested_voxels_per_angstrom: suggest as f32,
-            index_limit: too_many,
-        });
-    }
+    check_size(&grid, [x, y, z, r], params, budget)?;
 
     let bins = bin_atoms_by_slab(&grid, x, y, z, r);
     let plane = grid.dims[0] * grid.dims[1];

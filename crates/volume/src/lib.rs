@@ -80,6 +80,7 @@
 pub mod empty_space;
 mod gradient;
 pub mod grid;
+pub mod grid_size;
 pub mod light;
 pub mod macrocell;
 pub mod march;
@@ -97,6 +98,7 @@ pub use grid::{
     build_density, default_budget_bytes, density_work, estimate_bytes, DensityParams, Grid, Volume,
     VolumeData, VolumeFormat, Watch,
 };
+pub use grid_size::check_size;
 pub use macrocell::{Macrocells, MACROCELL};
 pub use march::{classify_values, march, march_rays, Rays};
 pub use medium::Medium;

@@ -190,6 +190,53 @@ fn refuses_over_budget_with_a_resolution_that_fits() {
     assert!(build_density(Isa::Scalar, &a.x, &a.y, &a.z, &a.r, &p, None).is_ok());
 }
 
+/// Resolutions and extents whose lattice does not fit 2³¹ points, up to past `usize`
+/// (which once wrapped to a 2-point axis and built a silently empty grid): refused, with a
+/// suggested resolution that itself fits (checked by building at it where that is cheap).
+#[test]
+fn refuses_lattices_past_the_index_limit_whatever_their_size() {
+    let (x, y, z, r) = ([0.0f32, 3.0], [0.0f32, 1.0], [0.0f32, -2.0], [1.0f32, 0.7]);
+    for vpa in [2e3f32, 1e9, 1e30, f32::MAX] {
+        let mut p = params(vpa, VolumeFormat::U8);
+        p.budget_bytes = Some(u64::MAX);
+        let err = build_density(Isa::Scalar, &x, &y, &z, &r, &p, None).unwrap_err();
+        let VolumeError::TooLarge {
+            suggested_voxels_per_angstrom: s,
+            index_limit: true,
+            ..
+        } = err
+        else {
+            panic!("{vpa} voxels/Å: expected TooLarge at the index limit, got {err:?}")
+        };
+        assert!(s > 1.0 && s < 2e3, "{vpa} voxels/Å: suggested {s}");
+        p.voxels_per_angstrom = s;
+        let v = build_density(Isa::Scalar, &x, &y, &z, &r, &p, None).unwrap();
+        assert!(v.grid.voxel_count() < 1 << 31 && v.max_value > 0.0);
+    }
+    // Atoms 10³⁸ Å apart: no lattice of any use; refused, suggesting a (tiny) resolution.
+    let p = params(4.0, VolumeFormat::U8);
+    let err = build_density(
+        Isa::Scalar,
+        &[0.0, 1e38],
+        &[0.0; 2],
+        &[0.0; 2],
+        &[1.0; 2],
+        &p,
+        None,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, VolumeError::TooLarge { suggested_voxels_per_angstrom: s, .. } if s > 0.0 && s < 1e-9),
+        "{err:?}"
+    );
+    assert!(
+        Grid::for_atoms(&[0.0, 1e38], &[0.0; 2], &[0.0; 2], &[1.0; 2], 4.0)
+            .unwrap()
+            .voxel_count()
+            >= 1 << 31
+    );
+}
+
 #[test]
 fn rejects_bad_input() {
     let p = params(4.0, VolumeFormat::F32);
